@@ -1,0 +1,1 @@
+"""Physics of the mechanical subsystems: plain Python, SI units, no FMI imports."""

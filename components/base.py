@@ -1,0 +1,107 @@
+"""The contract every mechanical subsystem fulfils.
+
+A component is plain Python (no FMI imports). It declares its variables once, in
+``VARIABLES``; the FMU wrapper, the scenario loader and the recorder all read that
+table, so a variable's name, unit and meaning are stated in exactly one place.
+
+Life cycle (mirrors FMI 2.0 co-simulation):
+
+1. ``Component(**parameters)``: parameters are set, everything else takes its start value.
+2. ``initialize(t0)``: derived quantities and consistent initial outputs are computed.
+3. ``step(t, h)``: advance from ``t`` to ``t + h`` with the inputs held at their current
+   values (zero-order hold).  Internal events are located inside the step; the regime
+   never changes inside an integrator stage.
+4. ``get_state()`` / ``set_state(s)``: a complete snapshot, including regime flags and
+   hidden variables, so that restoring and stepping again reproduces the same numbers
+   bit for bit.
+
+Every component outputs ``regime`` (Integer), ``stored_energy`` [J] and
+``dissipated_work`` [J] so that any run can be checked for energy balance.
+"""
+
+from __future__ import annotations
+
+import copy
+from dataclasses import dataclass
+from typing import Any, ClassVar, Literal
+
+Causality = Literal["parameter", "input", "output"]
+
+
+@dataclass(frozen=True)
+class Variable:
+    """One externally visible variable of a component, in SI units."""
+
+    name: str
+    causality: Causality
+    unit: str  # SI unit as an FMI unit name, e.g. "rad", "rad/s", "N.m", "kg.m2", "1"
+    start: float
+    description: str = ""
+    type: Literal["Real", "Integer"] = "Real"
+
+
+class ComponentError(RuntimeError):
+    """A component cannot go on (bad parameters, divergence, impossible state)."""
+
+
+class Component:
+    """Base class: parameter handling, state snapshot, variable access."""
+
+    #: Every variable visible from outside, in declaration order.
+    VARIABLES: ClassVar[tuple[Variable, ...]] = ()
+
+    def __init__(self, **parameters: float) -> None:
+        for var in self.VARIABLES:
+            value = var.start
+            setattr(self, var.name, int(value) if var.type == "Integer" else float(value))
+        known = {v.name for v in self.VARIABLES if v.causality == "parameter"}
+        for name, value in parameters.items():
+            if name not in known:
+                raise ComponentError(
+                    f"{type(self).__name__}: unknown parameter {name!r}; "
+                    f"expected one of {sorted(known)}"
+                )
+            setattr(self, name, float(value))
+
+    # -- life cycle -------------------------------------------------------------------
+    def initialize(self, t0: float) -> None:
+        """Compute derived quantities and consistent initial outputs."""
+
+    def step(self, t: float, h: float) -> None:
+        """Advance from t to t + h with inputs held."""
+        raise NotImplementedError
+
+    # -- state ------------------------------------------------------------------------
+    def get_state(self) -> dict[str, Any]:
+        """A complete, independent snapshot of everything the component holds."""
+        return copy.deepcopy(self.__dict__)
+
+    def set_state(self, state: dict[str, Any]) -> None:
+        """Restore a snapshot taken by get_state (the snapshot stays reusable)."""
+        self.__dict__.clear()
+        self.__dict__.update(copy.deepcopy(state))
+
+    # -- introspection ----------------------------------------------------------------
+    @classmethod
+    def variables(cls, causality: Causality | None = None) -> tuple[Variable, ...]:
+        if causality is None:
+            return cls.VARIABLES
+        return tuple(v for v in cls.VARIABLES if v.causality == causality)
+
+    @classmethod
+    def variable(cls, name: str) -> Variable:
+        for v in cls.VARIABLES:
+            if v.name == name:
+                return v
+        raise KeyError(name)
+
+    def values(self, names: list[str] | tuple[str, ...]) -> list[float]:
+        return [getattr(self, n) for n in names]
+
+
+# Variables every component carries; subclasses append their own.
+COMMON_OUTPUTS: tuple[Variable, ...] = (
+    Variable("regime", "output", "1", 0, "discrete regime (mode) index", "Integer"),
+    Variable("stored_energy", "output", "J", 0.0, "kinetic + potential energy held"),
+    Variable("dissipated_work", "output", "J", 0.0, "work dissipated since start"),
+)
