@@ -49,6 +49,10 @@ class Component:
 
     #: Every variable visible from outside, in declaration order.
     VARIABLES: ClassVar[tuple[Variable, ...]] = ()
+    #: Rotational ports: port name -> {role: variable}; roles are "angle", "speed", "torque"
+    #: and any extra signal a joint needs (e.g. "inertia").  Connecting two ports joins each
+    #: role present on both sides, from the side where it is an output to the other.
+    PORTS: ClassVar[dict[str, dict[str, str]]] = {}
 
     def __init__(self, **parameters: float) -> None:
         for var in self.VARIABLES:
@@ -70,6 +74,13 @@ class Component:
     def step(self, t: float, h: float) -> None:
         """Advance from t to t + h with inputs held."""
         raise NotImplementedError
+
+    def update_outputs(self) -> None:
+        """Recompute outputs that depend directly on inputs (direct feedthrough).
+
+        Called after inputs change and before outputs are read; a component without
+        feedthrough leaves it empty.
+        """
 
     # -- state ------------------------------------------------------------------------
     def get_state(self) -> dict[str, Any]:

@@ -1,0 +1,32 @@
+"""Which FMUs exist: the name a scene uses, the wrapper script, and the component inside."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+_HERE = Path(__file__).resolve().parent
+
+
+@dataclass(frozen=True)
+class FmuWrapper:
+    name: str  # model identifier, as a scene names it
+    script: Path  # pythonfmu script with exactly one ComponentSlave subclass
+    component: str  # dotted path of the component class
+
+
+def _wrapper(name: str, module: str, component: str) -> FmuWrapper:
+    return FmuWrapper(name, _HERE / f"{module}.py", component)
+
+
+FMU_WRAPPERS: dict[str, FmuWrapper] = {
+    w.name: w
+    for w in (
+        _wrapper("Inertia", "inertia_fmu", "components.rotational.Inertia"),
+        _wrapper(
+            "SpringDamperInertia",
+            "spring_damper_inertia_fmu",
+            "components.rotational.SpringDamperInertia",
+        ),
+    )
+}

@@ -1,0 +1,1 @@
+"""The master: scenario loading, FMU loading, coupling, events, recording, reports, CLI."""

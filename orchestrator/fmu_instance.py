@@ -1,0 +1,146 @@
+"""One instantiated co-simulation FMU, driven through fmpy.
+
+Names are resolved to value references once; the hot-path calls (set inputs, do_step,
+get outputs, get/set state) take prepared reference lists.  Messages the FMU logs are
+kept, so a failed step can say what the FMU said.
+"""
+
+from __future__ import annotations
+
+import atexit
+import hashlib
+import shutil
+from pathlib import Path
+from typing import Any
+
+from fmpy import extract, read_model_description
+from fmpy.fmi1 import FMICallException
+from fmpy.fmi2 import (
+    FMU2Slave,
+    fmi2CallbackAllocateMemoryTYPE,
+    fmi2CallbackFreeMemoryTYPE,
+    fmi2CallbackFunctions,
+    fmi2CallbackLoggerTYPE,
+)
+from fmpy.fmi2 import calloc, free  # the allocators fmpy itself hands to FMUs
+
+from orchestrator.errors import RunError
+
+
+_UNPACKED: dict[str, tuple[Any, str]] = {}
+
+
+def _unpacked(fmu_path: str) -> tuple[Any, str]:
+    """Model description and unzip directory, once per FMU file and process."""
+    if fmu_path not in _UNPACKED:
+        _UNPACKED[fmu_path] = (read_model_description(fmu_path), extract(fmu_path))
+    return _UNPACKED[fmu_path]
+
+
+@atexit.register
+def _remove_unpacked() -> None:
+    for _, directory in _UNPACKED.values():
+        shutil.rmtree(directory, ignore_errors=True)
+
+
+def file_sha256(path: Path) -> str:
+    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+
+
+class FmuInstance:
+    """An FMU instance with named access and error reporting."""
+
+    def __init__(self, instance_name: str, fmu_path: Path) -> None:
+        self.name = instance_name
+        self.path = Path(fmu_path)
+        md, unzip_dir = _unpacked(str(self.path))
+        self.model_description = md
+        self.variables = {v.name: v for v in md.modelVariables}
+        self.messages: list[str] = []
+        self._callbacks = fmi2CallbackFunctions()
+        self._callbacks.logger = fmi2CallbackLoggerTYPE(self._log)
+        self._callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
+        self._callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
+        self.fmu = FMU2Slave(
+            guid=md.guid,
+            unzipDirectory=unzip_dir,
+            modelIdentifier=md.coSimulation.modelIdentifier,
+            instanceName=instance_name,
+        )
+        self.fmu.instantiate(callbacks=self._callbacks, loggingOn=True)
+        self._alive = True
+
+    def _log(self, env: Any, instance: bytes, status: int, category: bytes, message: bytes) -> None:
+        self.messages.append(message.decode("utf-8", "replace") if message else "")
+
+    # -- names ------------------------------------------------------------------------
+    def refs(self, names: list[str] | tuple[str, ...]) -> list[int]:
+        try:
+            return [self.variables[n].valueReference for n in names]
+        except KeyError as exc:
+            raise RunError(f"has no variable {exc.args[0]!r}", fmu=self.name) from None
+
+    def is_integer(self, name: str) -> bool:
+        return self.variables[name].type == "Integer"
+
+    # -- life cycle -------------------------------------------------------------------
+    def initialize(self, start: float, stop: float, values: dict[str, float]) -> None:
+        """Set parameters and input start values, then leave initialization mode."""
+        try:
+            self.fmu.setupExperiment(startTime=start, stopTime=stop)
+            self.fmu.enterInitializationMode()
+            for name, value in values.items():
+                if self.is_integer(name):
+                    self.fmu.setInteger(self.refs([name]), [int(value)])
+                else:
+                    self.fmu.setReal(self.refs([name]), [value])
+            self.fmu.exitInitializationMode()
+        except FMICallException as exc:
+            raise RunError(f"initialization failed: {self.last_message() or exc}", start, self.name) from None
+
+    def do_step(self, t: float, h: float) -> None:
+        try:
+            self.fmu.doStep(t, h)
+        except FMICallException as exc:
+            self._alive = False
+            raise RunError(f"doStep failed: {self.last_message() or exc}", t, self.name) from None
+
+    def last_message(self) -> str:
+        return self.messages[-1].strip() if self.messages else ""
+
+    # -- values -----------------------------------------------------------------------
+    def get_real(self, refs: list[int]) -> list[float]:
+        return self.fmu.getReal(refs)
+
+    def set_real(self, refs: list[int], values: list[float]) -> None:
+        self.fmu.setReal(refs, values)
+
+    def get_integer(self, refs: list[int]) -> list[int]:
+        return self.fmu.getInteger(refs)
+
+    def get(self, name: str) -> float:
+        ref = self.refs([name])
+        return (self.fmu.getInteger(ref) if self.is_integer(name) else self.fmu.getReal(ref))[0]
+
+    # -- state ------------------------------------------------------------------------
+    def get_state(self) -> Any:
+        return self.fmu.getFMUState()
+
+    def set_state(self, state: Any) -> None:
+        self.fmu.setFMUState(state)
+
+    def free_state(self, state: Any) -> None:
+        self.fmu.freeFMUState(state)
+
+    def close(self) -> None:
+        if self.fmu is None:
+            return
+        try:
+            if self._alive:
+                self.fmu.terminate()
+        except FMICallException:
+            pass
+        # Free the instance but keep the shared library loaded: pythonfmu's runtime embeds
+        # the interpreter and does not survive being unloaded and loaded again in a process.
+        self.fmu.fmi2FreeInstance(self.fmu.component)
+        self.fmu = None

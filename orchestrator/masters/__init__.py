@@ -1,0 +1,10 @@
+"""Master algorithms.  Each takes (system, scene, recorder, stats, progress) and runs the scene."""
+
+from __future__ import annotations
+
+from orchestrator.masters.fixed_step import run_gauss_seidel, run_jacobi
+
+MASTERS = {
+    "jacobi": run_jacobi,
+    "gauss-seidel": run_gauss_seidel,
+}

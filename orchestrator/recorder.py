@@ -1,0 +1,80 @@
+"""Recording a run to files: time series (CSV), events, statistics, metadata, headline.
+
+Rows are written as they come, so a failed run keeps everything recorded up to the
+failure; ``close`` always writes the summary files, with the run's status.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+
+@dataclass
+class StepStats:
+    """Counters every master keeps."""
+
+    steps: int = 0  # accepted macro steps
+    do_steps: int = 0  # FMU doStep calls, all instances
+    rejections: int = 0  # steps rejected by an error or event test
+    rollbacks: int = 0  # restores of FMU state
+    iterations: int = 0  # coupling iterations beyond the first pass
+    events: int = 0  # located regime switches
+    wall_time: float = 0.0  # seconds, whole run
+    extra: dict[str, Any] = field(default_factory=dict)
+
+    def as_dict(self) -> dict[str, Any]:
+        d = {k: v for k, v in self.__dict__.items() if k != "extra"}
+        d.update(self.extra)
+        return d
+
+
+class Recorder:
+    """Writes ``timeseries.csv`` and ``events.csv`` under ``directory`` while a run goes on."""
+
+    def __init__(self, directory: Path, header: list[str]) -> None:
+        self.directory = Path(directory)
+        self.directory.mkdir(parents=True, exist_ok=True)
+        self.header = ["time", *header]
+        self.rows: list[list[float]] = []
+        self.events: list[tuple[float, str, str, str]] = []
+        self._file = open(self.directory / "timeseries.csv", "w", newline="")  # noqa: SIM115
+        self._writer = csv.writer(self._file)
+        self._writer.writerow(self.header)
+        self._events_file = open(self.directory / "events.csv", "w", newline="")  # noqa: SIM115
+        self._events_writer = csv.writer(self._events_file)
+        self._events_writer.writerow(["time", "subsystem", "from", "to"])
+
+    def row(self, values: list[float]) -> None:
+        self.rows.append(values)
+        self._writer.writerow([repr(v) for v in values])
+
+    def event(self, time: float, subsystem: str, before: str, after: str) -> None:
+        self.events.append((time, subsystem, before, after))
+        self._events_writer.writerow([repr(time), subsystem, before, after])
+
+    def array(self) -> np.ndarray:
+        return np.array(self.rows, dtype=float).reshape(-1, len(self.header))
+
+    def close(self, summary: dict[str, Any]) -> None:
+        """Flush the series and write ``summary.json`` (status, stats, metadata, headline)."""
+        for f in (self._file, self._events_file):
+            if not f.closed:
+                f.close()
+        with open(self.directory / "summary.json", "w") as f:
+            json.dump(summary, f, indent=2, default=_jsonable)
+
+
+def _jsonable(value: Any) -> Any:
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, Path):
+        return str(value)
+    return str(value)

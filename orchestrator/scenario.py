@@ -1,0 +1,351 @@
+"""Scenario files (TOML): schema, validation, conversion to SI.
+
+Everything a run needs is checked here, before any FMU is built or loaded.  Every error
+names the file, the key and what was expected.  The schema is documented in
+``scenarios/README.md``.
+"""
+
+from __future__ import annotations
+
+import importlib
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from components.base import Component
+from fmus.registry import FMU_WRAPPERS
+from orchestrator.errors import ScenarioError
+from orchestrator.units import to_si
+
+ALGORITHMS = ("jacobi", "gauss-seidel")
+REDUCTIONS = ("final", "initial", "max", "min", "maxabs", "mean")
+
+# Master settings: key -> (SI unit or None for a plain value, required?)
+_MASTER_KEYS: dict[str, tuple[str | None, bool]] = {
+    "algorithm": (None, True),
+    "step": ("s", True),
+    "order": (None, False),
+    "tolerance": ("1", False),
+    "event_tolerance": ("s", False),
+    "min_step": ("s", False),
+    "max_step": ("s", False),
+    "max_iterations": (None, False),
+    "max_events_per_step": (None, False),
+}
+
+
+@dataclass(frozen=True)
+class FmuSpec:
+    instance: str
+    fmu: str  # name in fmus.registry
+    parameters: dict[str, float]
+    inputs: dict[str, float]  # start values of inputs
+
+
+@dataclass(frozen=True)
+class Connection:
+    source: tuple[str, str]  # (instance, output variable)
+    target: tuple[str, str]  # (instance, input variable)
+
+
+@dataclass(frozen=True)
+class MasterSpec:
+    algorithm: str
+    step: float
+    order: tuple[str, ...]
+    options: dict[str, Any] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class HeadlineSpec:
+    signal: tuple[str, str]
+    reduce: str
+    unit: str
+
+
+@dataclass(frozen=True)
+class Scene:
+    path: Path
+    name: str
+    description: str
+    start: float
+    stop: float
+    fmus: dict[str, FmuSpec]
+    connections: tuple[Connection, ...]
+    master: MasterSpec
+    record: tuple[tuple[str, str], ...]
+    record_every: int
+    output_dir: Path
+    headline: dict[str, HeadlineSpec]
+    analysis: str | None
+    analysis_options: dict[str, Any]
+
+    def component_class(self, instance: str) -> type[Component]:
+        return component_class(self.fmus[instance].fmu)
+
+
+def component_class(fmu_name: str) -> type[Component]:
+    module_name, class_name = FMU_WRAPPERS[fmu_name].component.rsplit(".", 1)
+    return getattr(importlib.import_module(module_name), class_name)
+
+
+def load_scene(path: str | Path, overrides: dict[str, Any] | None = None) -> Scene:
+    """Read, validate and convert a scenario file; ``overrides`` patch the raw TOML first.
+
+    Overrides use dotted keys, e.g. {"master.step": "1 ms", "fmus.a.parameters.J": 2e-3}.
+    """
+    path = Path(path)
+    try:
+        raw = tomllib.loads(path.read_text())
+    except FileNotFoundError:
+        raise ScenarioError(path, "", "file not found") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise ScenarioError(path, "", f"not valid TOML: {exc}") from None
+    for dotted, value in (overrides or {}).items():
+        _set_dotted(raw, dotted, value)
+    return _Loader(path, raw).scene()
+
+
+def _set_dotted(raw: dict[str, Any], dotted: str, value: Any) -> None:
+    *parents, last = dotted.split(".")
+    node = raw
+    for key in parents:
+        node = node.setdefault(key, {})
+    node[last] = value
+
+
+class _Loader:
+    def __init__(self, path: Path, raw: dict[str, Any]) -> None:
+        self.path, self.raw = path, raw
+
+    def fail(self, key: str, message: str) -> ScenarioError:
+        return ScenarioError(self.path, key, message)
+
+    def table(self, node: Any, key: str) -> dict[str, Any]:
+        if not isinstance(node, dict):
+            raise self.fail(key, f"expected a table, got {type(node).__name__}")
+        return node
+
+    def check_keys(self, node: dict[str, Any], key: str, allowed: set[str]) -> None:
+        unknown = sorted(set(node) - allowed)
+        if unknown:
+            where = f"{key}.{unknown[0]}" if key else unknown[0]
+            raise self.fail(where, f"unknown key; expected one of {sorted(allowed)}")
+
+    def quantity(self, value: Any, key: str, unit: str) -> float:
+        try:
+            return to_si(value, unit)
+        except ValueError as exc:
+            raise self.fail(key, f"{exc} (expected a value in {unit})") from None
+
+    def string(self, node: dict[str, Any], key: str, dotted: str, default: str | None = None) -> str:
+        if key not in node:
+            if default is None:
+                raise self.fail(dotted, "missing; expected a string")
+            return default
+        if not isinstance(node[key], str):
+            raise self.fail(dotted, f"expected a string, got {node[key]!r}")
+        return node[key]
+
+    # -- sections ---------------------------------------------------------------------
+    def scene(self) -> Scene:
+        raw = self.table(self.raw, "")
+        self.check_keys(raw, "", {"scene", "fmus", "connections", "master", "output", "report"})
+        for section in ("scene", "fmus", "master"):
+            if section not in raw:
+                raise self.fail(section, "missing section")
+        head = self.table(raw["scene"], "scene")
+        self.check_keys(head, "scene", {"name", "description", "start", "stop"})
+        name = self.string(head, "name", "scene.name")
+        start = self.quantity(head.get("start", 0.0), "scene.start", "s")
+        if "stop" not in head:
+            raise self.fail("scene.stop", "missing; expected the stop time, e.g. '0.1 s'")
+        stop = self.quantity(head["stop"], "scene.stop", "s")
+        if not stop > start:
+            raise self.fail("scene.stop", f"must be later than scene.start ({start} s), got {stop}")
+        fmus = self.fmus(self.table(raw["fmus"], "fmus"))
+        connections = self.connections(raw.get("connections", []), fmus)
+        master = self.master(self.table(raw["master"], "master"), fmus, stop - start)
+        record, every, out_dir = self.output(self.table(raw.get("output", {}), "output"), fmus, name)
+        headline, analysis, options = self.report(self.table(raw.get("report", {}), "report"), fmus)
+        return Scene(
+            path=self.path,
+            name=name,
+            description=head.get("description", ""),
+            start=start,
+            stop=stop,
+            fmus=fmus,
+            connections=connections,
+            master=master,
+            record=record,
+            record_every=every,
+            output_dir=out_dir,
+            headline=headline,
+            analysis=analysis,
+            analysis_options=options,
+        )
+
+    def fmus(self, node: dict[str, Any]) -> dict[str, FmuSpec]:
+        if not node:
+            raise self.fail("fmus", "no FMU given; expected at least one [fmus.<instance>] table")
+        specs = {}
+        for instance, entry in node.items():
+            key = f"fmus.{instance}"
+            entry = self.table(entry, key)
+            self.check_keys(entry, key, {"component", "parameters", "inputs"})
+            fmu = self.string(entry, "component", f"{key}.component")
+            if fmu not in FMU_WRAPPERS:
+                raise self.fail(f"{key}.component", f"unknown {fmu!r}; expected one of {sorted(FMU_WRAPPERS)}")
+            cls = component_class(fmu)
+            params = self.values(entry.get("parameters", {}), f"{key}.parameters", cls, "parameter")
+            inputs = self.values(entry.get("inputs", {}), f"{key}.inputs", cls, "input")
+            specs[instance] = FmuSpec(instance, fmu, params, inputs)
+        return specs
+
+    def values(self, node: Any, key: str, cls: type[Component], causality: str) -> dict[str, float]:
+        node = self.table(node, key)
+        declared = {v.name: v for v in cls.variables(causality)}  # type: ignore[arg-type]
+        self.check_keys(node, key, set(declared))
+        return {name: self.quantity(v, f"{key}.{name}", declared[name].unit) for name, v in node.items()}
+
+    def signal(self, text: Any, key: str, fmus: dict[str, FmuSpec], causality: str | None) -> tuple[str, str]:
+        if not isinstance(text, str) or text.count(".") != 1:
+            raise self.fail(key, f"expected '<instance>.<variable>', got {text!r}")
+        instance, var = text.split(".")
+        if instance not in fmus:
+            raise self.fail(key, f"no FMU instance {instance!r}; expected one of {sorted(fmus)}")
+        cls = component_class(fmus[instance].fmu)
+        names = {v.name: v for v in cls.VARIABLES}
+        if var not in names or (causality and names[var].causality != causality):
+            wanted = [v.name for v in cls.VARIABLES if not causality or v.causality == causality]
+            kind = f"{causality} " if causality else ""
+            raise self.fail(key, f"{instance!r} ({fmus[instance].fmu}) has no {kind}variable {var!r}; expected one of {wanted}")
+        return instance, var
+
+    def connections(self, node: Any, fmus: dict[str, FmuSpec]) -> tuple[Connection, ...]:
+        if not isinstance(node, list):
+            raise self.fail("connections", "expected an array of tables ([[connections]])")
+        result: list[Connection] = []
+        for i, entry in enumerate(node):
+            key = f"connections[{i}]"
+            entry = self.table(entry, key)
+            if "ports" in entry:
+                self.check_keys(entry, key, {"ports"})
+                result.extend(self.port_connection(entry["ports"], f"{key}.ports", fmus))
+            else:
+                self.check_keys(entry, key, {"from", "to"})
+                for side in ("from", "to"):
+                    if side not in entry:
+                        raise self.fail(f"{key}.{side}", "missing; expected '<instance>.<variable>'")
+                src = self.signal(entry["from"], f"{key}.from", fmus, "output")
+                dst = self.signal(entry["to"], f"{key}.to", fmus, "input")
+                result.append(Connection(src, dst))
+        targets = [c.target for c in result]
+        for t in targets:
+            if targets.count(t) > 1:
+                raise self.fail("connections", f"input {'.'.join(t)} is driven by more than one output")
+        return tuple(result)
+
+    def port_connection(self, ports: Any, key: str, fmus: dict[str, FmuSpec]) -> list[Connection]:
+        if not (isinstance(ports, list) and len(ports) == 2 and all(isinstance(p, str) for p in ports)):
+            raise self.fail(key, "expected two ports, e.g. ['train.escape_wheel', 'verge.wheel']")
+        sides = []
+        for port in ports:
+            if port.count(".") != 1 or port.split(".")[0] not in fmus:
+                raise self.fail(key, f"expected '<instance>.<port>' with a known instance, got {port!r}")
+            instance, name = port.split(".")
+            cls = component_class(fmus[instance].fmu)
+            if name not in cls.PORTS:
+                raise self.fail(key, f"{instance!r} has no port {name!r}; expected one of {sorted(cls.PORTS)}")
+            sides.append((instance, cls, cls.PORTS[name]))
+        (ia, ca, pa), (ib, cb, pb) = sides
+        roles = sorted(set(pa) & set(pb))
+        if not roles:
+            raise self.fail(key, f"ports {ports} share no role (angle, speed, torque, ...)")
+        out = []
+        for role in roles:
+            va, vb = ca.variable(pa[role]), cb.variable(pb[role])
+            if va.causality == "output" and vb.causality == "input":
+                out.append(Connection((ia, va.name), (ib, vb.name)))
+            elif vb.causality == "output" and va.causality == "input":
+                out.append(Connection((ib, vb.name), (ia, va.name)))
+            else:
+                raise self.fail(key, f"role {role!r}: one side must output it and the other take it as input")
+        return out
+
+    def master(self, node: dict[str, Any], fmus: dict[str, FmuSpec], duration: float) -> MasterSpec:
+        self.check_keys(node, "master", set(_MASTER_KEYS))
+        for k, (_, required) in _MASTER_KEYS.items():
+            if required and k not in node:
+                raise self.fail(f"master.{k}", "missing")
+        algorithm = self.string(node, "algorithm", "master.algorithm")
+        if algorithm not in ALGORITHMS:
+            raise self.fail("master.algorithm", f"unknown {algorithm!r}; expected one of {list(ALGORITHMS)}")
+        step = self.quantity(node["step"], "master.step", "s")
+        if not step > 0.0:
+            raise self.fail("master.step", f"must be positive, got {step} s")
+        if step > duration:
+            raise self.fail("master.step", f"{step} s is longer than the run ({duration} s)")
+        order = node.get("order", list(fmus))
+        if not (isinstance(order, list) and sorted(order) == sorted(fmus)):
+            raise self.fail("master.order", f"expected every instance once, from {sorted(fmus)}")
+        options: dict[str, Any] = {}
+        for k, (unit, _) in _MASTER_KEYS.items():
+            if k in ("algorithm", "step", "order") or k not in node:
+                continue
+            if unit is None:
+                if not isinstance(node[k], int) or isinstance(node[k], bool) or node[k] < 1:
+                    raise self.fail(f"master.{k}", f"expected a positive integer, got {node[k]!r}")
+                options[k] = node[k]
+            else:
+                value = self.quantity(node[k], f"master.{k}", unit)
+                if not value > 0.0:
+                    raise self.fail(f"master.{k}", f"must be positive, got {value}")
+                options[k] = value
+        return MasterSpec(algorithm, step, tuple(order), options)
+
+    def output(self, node: dict[str, Any], fmus: dict[str, FmuSpec], name: str):
+        self.check_keys(node, "output", {"directory", "record", "every"})
+        record_raw = node.get("record")
+        if record_raw is None:  # default: every output of every FMU
+            record = tuple(
+                (inst, v.name)
+                for inst, spec in fmus.items()
+                for v in component_class(spec.fmu).variables("output")
+            )
+        else:
+            if not isinstance(record_raw, list):
+                raise self.fail("output.record", "expected a list of '<instance>.<variable>'")
+            record = tuple(self.signal(s, "output.record", fmus, None) for s in record_raw)
+        every = node.get("every", 1)
+        if not isinstance(every, int) or isinstance(every, bool) or every < 1:
+            raise self.fail("output.every", f"expected a positive integer, got {every!r}")
+        directory = node.get("directory", f"runs/{name}")
+        if not isinstance(directory, str):
+            raise self.fail("output.directory", f"expected a path string, got {directory!r}")
+        return record, every, Path(directory)
+
+    def report(self, node: dict[str, Any], fmus: dict[str, FmuSpec]):
+        self.check_keys(node, "report", {"headline", "analysis", "options"})
+        headline: dict[str, HeadlineSpec] = {}
+        for hname, entry in self.table(node.get("headline", {}), "report.headline").items():
+            key = f"report.headline.{hname}"
+            entry = self.table(entry, key)
+            self.check_keys(entry, key, {"signal", "reduce"})
+            if "signal" not in entry:
+                raise self.fail(f"{key}.signal", "missing; expected '<instance>.<variable>'")
+            signal = self.signal(entry["signal"], f"{key}.signal", fmus, None)
+            reduce = entry.get("reduce", "final")
+            if reduce not in REDUCTIONS:
+                raise self.fail(f"{key}.reduce", f"unknown {reduce!r}; expected one of {list(REDUCTIONS)}")
+            unit = component_class(fmus[signal[0]].fmu).variable(signal[1]).unit
+            headline[hname] = HeadlineSpec(signal, reduce, unit)
+        analysis = node.get("analysis")
+        if analysis is not None:
+            from orchestrator.analyses import ANALYSES
+
+            if analysis not in ANALYSES:
+                raise self.fail("report.analysis", f"unknown {analysis!r}; expected one of {sorted(ANALYSES)}")
+        options = self.table(node.get("options", {}), "report.options")
+        return headline, analysis, dict(options)

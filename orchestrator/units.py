@@ -1,0 +1,48 @@
+"""Scenario values with units, converted once at load to the SI unit a variable declares."""
+
+from __future__ import annotations
+
+import re
+from functools import lru_cache
+
+import pint
+
+UREG = pint.UnitRegistry()
+_POWER = re.compile(r"([A-Za-z]+)(-?\d+)")
+
+
+@lru_cache(maxsize=None)
+def pint_unit(fmi_unit: str) -> pint.Unit:
+    """'N.m.s/rad' -> N*m*s/rad, 'kg.m2' -> kg*m**2, '1' -> dimensionless."""
+    if fmi_unit == "1":
+        return UREG.dimensionless
+    text = _POWER.sub(r"\1**\2", fmi_unit.replace(".", "*"))
+    numerator, _, denominator = text.partition("/")
+    expr = numerator if not denominator else f"({numerator})/({denominator.replace('*', '/')})"
+    return UREG.Unit(expr)
+
+
+def to_si(value: object, fmi_unit: str) -> float:
+    """A number (taken as already SI) or a string such as '0.4701 in' -> float in fmi_unit.
+
+    Raises ValueError with a message naming the expected unit.
+    """
+    if isinstance(value, bool):
+        raise ValueError(f"expected a number or a quantity in {fmi_unit}, got a boolean")
+    if isinstance(value, int | float):
+        return float(value)
+    if not isinstance(value, str):
+        raise ValueError(f"expected a number or a quantity in {fmi_unit}, got {value!r}")
+    try:
+        quantity = UREG.Quantity(value.strip())
+    except Exception as exc:  # pint raises several unrelated types for bad text
+        raise ValueError(f"cannot read {value!r} as a quantity ({exc})") from None
+    target = pint_unit(fmi_unit)
+    try:
+        if isinstance(quantity, int | float):
+            return float(quantity)
+        return float(quantity.to(target).magnitude)
+    except pint.DimensionalityError:
+        raise ValueError(
+            f"{value!r} has units of {quantity.units:~}, which cannot be converted to {fmi_unit}"
+        ) from None
