@@ -16,7 +16,9 @@ Life cycle (mirrors FMI 2.0 co-simulation):
    bit for bit.
 
 Every component outputs ``regime`` (Integer), ``stored_energy`` [J] and
-``dissipated_work`` [J] so that any run can be checked for energy balance.
+``dissipated_work`` [J]; a component that brings work in from outside the scene (a
+prescribed drive, a spin field) also outputs ``external_work`` [J].  Any run that records
+these can be checked for energy balance: stored + dissipated - external = constant.
 """
 
 from __future__ import annotations

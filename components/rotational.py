@@ -24,7 +24,7 @@ class Inertia(Component):
         Variable("tau", "input", "N.m", 0.0, "torque applied to the body"),
         Variable("phi", "output", "rad", 0.0, "angle"),
         Variable("w", "output", "rad/s", 0.0, "angular velocity"),
-        Variable("input_work", "output", "J", 0.0, "work done on the body by tau"),
+        Variable("port_work", "output", "J", 0.0, "work done on the body through its flange"),
         *COMMON_OUTPUTS,
     )
     PORTS = {"flange": {"angle": "phi", "speed": "w", "torque": "tau"}}
@@ -33,14 +33,14 @@ class Inertia(Component):
         if not self.J > 0.0:
             raise ComponentError(f"Inertia: J must be positive, got {self.J}")
         self.phi, self.w = self.phi0, self.w0
-        self.input_work = 0.0
+        self.port_work = 0.0
         self.stored_energy = 0.5 * self.J * self.w**2
 
     def step(self, t: float, h: float) -> None:
         # Constant torque over the step: the motion is an exact parabola.
         alpha = self.tau / self.J
         dphi = self.w * h + 0.5 * alpha * h * h
-        self.input_work += self.tau * dphi
+        self.port_work += self.tau * dphi
         self.phi += dphi
         self.w += alpha * h
         self.stored_energy = 0.5 * self.J * self.w**2
@@ -59,6 +59,7 @@ class SpringDamperInertia(Component):
         Variable("J", "parameter", "kg.m2", 1.0e-3, "moment of inertia"),
         Variable("k", "parameter", "N.m/rad", 10.0, "torsional stiffness"),
         Variable("d", "parameter", "N.m.s/rad", 0.01, "torsional damping"),
+        Variable("max_twist", "parameter", "rad", 1.0e30, "twist at which the coupling breaks"),
         Variable("phi0", "parameter", "rad", 0.0, "initial angle"),
         Variable("w0", "parameter", "rad/s", 0.0, "initial angular velocity"),
         Variable("phi_in", "input", "rad", 0.0, "angle of the other body's port"),
@@ -100,6 +101,10 @@ class SpringDamperInertia(Component):
         e0 = 0.5 * self.J * v0**2 + 0.5 * self.k * y0**2
         e1 = 0.5 * self.J * v1**2 + 0.5 * self.k * y1**2
         self.dissipated_work += e0 - e1
+        if abs(y1) > self.max_twist:
+            raise ComponentError(
+                f"twist {abs(y1):.6g} rad exceeds the coupling's limit {self.max_twist:.6g} rad"
+            )
         self.phi_in += self.w_in * h
         self.phi = self.phi_in + y1
         self.w = self.w_in + v1

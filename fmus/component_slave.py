@@ -57,6 +57,9 @@ class ComponentSlave(Fmi2Slave):
         self._names: list[str] = []
         self._inputs: set[int] = set()
         self._feedthrough_stale = False
+        self._initializing = False
+        self._init_stale = False
+        self._start_time = 0.0
         for var in self.component_class.VARIABLES:
             self._register(var)
 
@@ -85,12 +88,32 @@ class ComponentSlave(Fmi2Slave):
         self._names.append(name)
 
     # -- life cycle -------------------------------------------------------------------
-    def exit_initialization_mode(self) -> None:
-        self._start_time = getattr(self, "_start_time", 0.0)
-        self.component.initialize(self._start_time)
-
+    # Outputs must be valid in initialization mode too (a master reads them there to set
+    # consistent inputs), so the component is (re)initialized from the current parameters
+    # whenever something was set and an output is read, and once more on leaving the mode.
     def setup_experiment(self, start_time: float, stop_time: float | None, tolerance: float | None):
         self._start_time = float(start_time)
+
+    def enter_initialization_mode(self) -> None:
+        self._initializing = True
+        self._init_stale = True
+
+    def exit_initialization_mode(self) -> None:
+        self.component.initialize(self._start_time)
+        self.component.update_outputs()
+        self._initializing = False
+        self._init_stale = False
+        self._feedthrough_stale = False
+
+    def _refresh(self) -> None:
+        if self._initializing:
+            if self._init_stale:
+                self.component.initialize(self._start_time)
+                self.component.update_outputs()
+                self._init_stale = False
+        elif self._feedthrough_stale:
+            self.component.update_outputs()
+        self._feedthrough_stale = False
 
     def do_step(self, current_time: float, step_size: float) -> bool:
         try:
@@ -108,18 +131,16 @@ class ComponentSlave(Fmi2Slave):
 
     # -- lean variable access (the hot path of every master step) ----------------------
     def get_real(self, vrs: list[int]) -> list[float]:
+        if self._feedthrough_stale or self._initializing:
+            self._refresh()
         comp = self.component
-        if self._feedthrough_stale:
-            comp.update_outputs()
-            self._feedthrough_stale = False
         names = self._names
         return [float(getattr(comp, names[vr])) for vr in vrs]
 
     def get_integer(self, vrs: list[int]) -> list[int]:
+        if self._feedthrough_stale or self._initializing:
+            self._refresh()
         comp = self.component
-        if self._feedthrough_stale:
-            comp.update_outputs()
-            self._feedthrough_stale = False
         names = self._names
         return [int(getattr(comp, names[vr])) for vr in vrs]
 
@@ -128,14 +149,14 @@ class ComponentSlave(Fmi2Slave):
         names = self._names
         for vr, value in zip(vrs, values, strict=True):
             setattr(comp, names[vr], float(value))
-        self._feedthrough_stale = True
+        self._feedthrough_stale = self._init_stale = True
 
     def set_integer(self, vrs: list[int], values: list[int]) -> None:
         comp = self.component
         names = self._names
         for vr, value in zip(vrs, values, strict=True):
             setattr(comp, names[vr], int(value))
-        self._feedthrough_stale = True
+        self._feedthrough_stale = self._init_stale = True
 
     # -- complete state ---------------------------------------------------------------
     def _get_fmu_state(self) -> dict[str, Any]:

@@ -35,6 +35,32 @@ def headline(scene: Scene, header: list[str], data: np.ndarray) -> dict[str, dic
     return out
 
 
+def energy_residual(header: list[str], data: np.ndarray) -> dict[str, Any] | None:
+    """Largest drift of stored + dissipated - external energy, relative to its scale.
+
+    Needs every FMU's stored_energy and dissipated_work recorded (and external_work where a
+    component has it); returns None when they are not.
+    """
+    instances = {h.split(".")[0] for h in header[1:]}
+    total = np.zeros(len(data))
+    scale = 0.0
+    for inst in sorted(instances):
+        try:
+            stored = _column(header, data, f"{inst}.stored_energy")
+            dissipated = _column(header, data, f"{inst}.dissipated_work")
+        except ValueError:
+            return None
+        total += stored + dissipated
+        scale = max(scale, float(np.max(np.abs(stored))))
+        if f"{inst}.external_work" in header:
+            external = _column(header, data, f"{inst}.external_work")
+            total -= external
+            scale = max(scale, float(np.max(np.abs(external))))
+    if len(data) == 0 or scale == 0.0:
+        return None
+    return {"value": float(np.max(np.abs(total - total[0])) / scale), "unit": "1"}
+
+
 def _column(header: list[str], data: np.ndarray, name: str) -> np.ndarray:
     return data[:, header.index(name)]
 

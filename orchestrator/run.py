@@ -19,7 +19,7 @@ import numpy as np
 from tqdm import tqdm
 
 from fmus.build import build_fmu
-from orchestrator.analyses import ANALYSES, headline
+from orchestrator.analyses import ANALYSES, energy_residual, headline
 from orchestrator.errors import RunError
 from orchestrator.fmu_instance import file_sha256
 from orchestrator.masters import MASTERS
@@ -93,6 +93,9 @@ def run_scene(
         system.close()
     data = recorder.array()
     quantities = headline(scene, recorder.header, data)
+    residual = energy_residual(recorder.header, data)
+    if residual is not None:
+        quantities["energy_residual"] = residual
     if scene.analysis and status == "completed":
         quantities.update(ANALYSES[scene.analysis](scene, recorder.header, data, scene.analysis_options))
     recorder.close(

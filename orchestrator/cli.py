@@ -1,0 +1,148 @@
+"""The ``mechcosim`` command: run scenes, build and validate FMUs, read reports."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import tomllib
+from pathlib import Path
+
+from orchestrator.errors import RunError, ScenarioError
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="mechcosim", description=__doc__)
+    sub = parser.add_subparsers(dest="command", required=True)
+
+    p = sub.add_parser("run", help="run a scene and write its results")
+    p.add_argument("scene", type=Path, help="scenario file (TOML)")
+    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                   help="override a scenario value, e.g. --set master.step='0.5 ms'")
+    p.add_argument("--output", type=Path, help="results directory (default: the scene's)")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    p.set_defaults(handler=_run)
+
+    p = sub.add_parser("check", help="validate a scenario file without running it")
+    p.add_argument("scene", type=Path, nargs="+")
+    p.set_defaults(handler=_check)
+
+    p = sub.add_parser("build", help="build FMUs (all if none named) into the cache")
+    p.add_argument("names", nargs="*")
+    p.add_argument("--force", action="store_true", help="rebuild even if cached")
+    p.add_argument("--dest", type=Path, help="cache directory (default: user cache)")
+    p.set_defaults(handler=_build)
+
+    p = sub.add_parser("validate", help="validate FMUs: fmpy validation, standalone run, state round trip")
+    p.add_argument("names", nargs="*")
+    p.set_defaults(handler=_validate)
+
+    p = sub.add_parser("crosscheck", help="run a scene in libcosim too and compare with our Jacobi master")
+    p.add_argument("scene", type=Path)
+    p.set_defaults(handler=_crosscheck)
+
+    p = sub.add_parser("report", help="print the summary of a finished run")
+    p.add_argument("run_dir", type=Path)
+    p.set_defaults(handler=_report)
+
+    args = parser.parse_args(argv)
+    try:
+        return args.handler(args)
+    except (ScenarioError, RunError) as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+
+
+def _overrides(pairs: list[str]) -> dict[str, object]:
+    out: dict[str, object] = {}
+    for pair in pairs:
+        key, sep, text = pair.partition("=")
+        if not sep:
+            raise ScenarioError("--set", pair, "expected KEY=VALUE")
+        try:  # a TOML value (number, quoted string, array) ...
+            out[key] = tomllib.loads(f"v = {text}")["v"]
+        except tomllib.TOMLDecodeError:  # ... or a bare string such as 0.5 ms
+            out[key] = text
+    return out
+
+
+def _run(args: argparse.Namespace) -> int:
+    from orchestrator.run import run_scene
+    from orchestrator.scenario import load_scene
+
+    scene = load_scene(args.scene, _overrides(args.set))
+    result = run_scene(scene, output_dir=args.output, show_progress=not args.no_progress)
+    print(f"scene {scene.name}: {result.status}" + (f" — {result.message}" if result.message else ""))
+    for name, q in result.headline.items():
+        print(f"  {name:32s} {q['value']:.10g} {q['unit']}")
+    s = result.stats
+    print(f"  steps {s.steps}, doSteps {s.do_steps}, rejections {s.rejections}, "
+          f"rollbacks {s.rollbacks}, events {s.events}, wall time {s.wall_time:.3f} s")
+    print(f"  results in {result.output_dir}")
+    return 0 if result.status == "completed" else 1
+
+
+def _check(args: argparse.Namespace) -> int:
+    from orchestrator.scenario import load_scene
+
+    for path in args.scene:
+        scene = load_scene(path)
+        print(f"{path}: ok ({scene.name}, {len(scene.fmus)} FMUs, {len(scene.connections)} connections)")
+    return 0
+
+
+def _build(args: argparse.Namespace) -> int:
+    from fmus.build import build_fmu
+    from fmus.registry import FMU_WRAPPERS
+
+    for name in args.names or sorted(FMU_WRAPPERS):
+        print(build_fmu(name, args.dest, force=args.force))
+    return 0
+
+
+def _validate(args: argparse.Namespace) -> int:
+    from fmus.registry import FMU_WRAPPERS
+    from orchestrator.fmu_checks import check_fmu
+
+    failures = 0
+    for name in args.names or sorted(FMU_WRAPPERS):
+        problems = check_fmu(name)
+        print(f"{name}: {'ok' if not problems else 'FAILED'}")
+        for problem in problems:
+            print(f"  - {problem}")
+        failures += bool(problems)
+    return 1 if failures else 0
+
+
+def _crosscheck(args: argparse.Namespace) -> int:
+    import numpy as np
+
+    from orchestrator.crosscheck import run_with_libcosim
+    from orchestrator.run import run_scene
+    from orchestrator.scenario import load_scene
+
+    scene = load_scene(args.scene, {"master.algorithm": "jacobi"})
+    ours = run_scene(scene, show_progress=False)
+    header, theirs = run_with_libcosim(scene)
+    columns = [ours.header.index(h) for h in header]
+    n = min(len(theirs), len(ours.data) - 1)
+    diff = np.abs(theirs[:n] - ours.data[1 : n + 1][:, columns])
+    for j, name in enumerate(header[1:], start=1):
+        print(f"  {name:28s} max |ours - libcosim| = {diff[:, j].max():.3e}")
+    worst = float(diff[:, 1:].max())
+    print(f"largest difference {worst:.3e} over {n} steps of {scene.master.step} s")
+    return 0 if worst <= 1e-9 else 1
+
+
+def _report(args: argparse.Namespace) -> int:
+    summary_file = args.run_dir / "summary.json"
+    if not summary_file.exists():
+        print(f"error: {summary_file} not found: not a run directory", file=sys.stderr)
+        return 2
+    summary = json.loads(summary_file.read_text())
+    print(json.dumps({k: summary[k] for k in ("scene", "status", "message", "headline", "stats")}, indent=2))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
