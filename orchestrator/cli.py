@@ -17,8 +17,13 @@ def main(argv: list[str] | None = None) -> int:
 
     p = sub.add_parser("run", help="run a scene and write its results")
     p.add_argument("scene", type=Path, help="scenario file (TOML)")
-    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
-                   help="override a scenario value, e.g. --set master.step='0.5 ms'")
+    p.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="override a scenario value, e.g. --set master.step='0.5 ms'",
+    )
     p.add_argument("--output", type=Path, help="results directory (default: the scene's)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.set_defaults(handler=_run)
@@ -33,13 +38,21 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--dest", type=Path, help="cache directory (default: user cache)")
     p.set_defaults(handler=_build)
 
-    p = sub.add_parser("validate", help="validate FMUs: fmpy validation, standalone run, state round trip")
+    p = sub.add_parser(
+        "validate", help="validate FMUs: fmpy validation, standalone run, state round trip"
+    )
     p.add_argument("names", nargs="*")
     p.set_defaults(handler=_validate)
 
-    p = sub.add_parser("crosscheck", help="run a scene in libcosim too and compare with our Jacobi master")
+    p = sub.add_parser(
+        "crosscheck", help="run a scene in libcosim too and compare with our Jacobi master"
+    )
     p.add_argument("scene", type=Path)
     p.set_defaults(handler=_crosscheck)
+
+    p = sub.add_parser("bench", help="run a benchmark (prints ratios against its baseline)")
+    p.add_argument("name", choices=["overhead"])
+    p.set_defaults(handler=_bench)
 
     p = sub.add_parser("report", help="print the summary of a finished run")
     p.add_argument("run_dir", type=Path)
@@ -72,12 +85,16 @@ def _run(args: argparse.Namespace) -> int:
 
     scene = load_scene(args.scene, _overrides(args.set))
     result = run_scene(scene, output_dir=args.output, show_progress=not args.no_progress)
-    print(f"scene {scene.name}: {result.status}" + (f" — {result.message}" if result.message else ""))
+    print(
+        f"scene {scene.name}: {result.status}" + (f" — {result.message}" if result.message else "")
+    )
     for name, q in result.headline.items():
         print(f"  {name:32s} {q['value']:.10g} {q['unit']}")
     s = result.stats
-    print(f"  steps {s.steps}, doSteps {s.do_steps}, rejections {s.rejections}, "
-          f"rollbacks {s.rollbacks}, events {s.events}, wall time {s.wall_time:.3f} s")
+    print(
+        f"  steps {s.steps}, doSteps {s.do_steps}, rejections {s.rejections}, "
+        f"rollbacks {s.rollbacks}, events {s.events}, wall time {s.wall_time:.3f} s"
+    )
     print(f"  results in {result.output_dir}")
     return 0 if result.status == "completed" else 1
 
@@ -87,7 +104,8 @@ def _check(args: argparse.Namespace) -> int:
 
     for path in args.scene:
         scene = load_scene(path)
-        print(f"{path}: ok ({scene.name}, {len(scene.fmus)} FMUs, {len(scene.connections)} connections)")
+        counts = f"{len(scene.fmus)} FMUs, {len(scene.connections)} connections"
+        print(f"{path}: ok ({scene.name}, {counts})")
     return 0
 
 
@@ -134,13 +152,24 @@ def _crosscheck(args: argparse.Namespace) -> int:
     return 0 if worst <= 1e-9 else 1
 
 
+def _bench(args: argparse.Namespace) -> int:
+    from orchestrator.benchmarks import BENCHMARKS
+
+    BENCHMARKS[args.name]()
+    return 0
+
+
 def _report(args: argparse.Namespace) -> int:
     summary_file = args.run_dir / "summary.json"
     if not summary_file.exists():
         print(f"error: {summary_file} not found: not a run directory", file=sys.stderr)
         return 2
     summary = json.loads(summary_file.read_text())
-    print(json.dumps({k: summary[k] for k in ("scene", "status", "message", "headline", "stats")}, indent=2))
+    print(
+        json.dumps(
+            {k: summary[k] for k in ("scene", "status", "message", "headline", "stats")}, indent=2
+        )
+    )
     return 0
 
 

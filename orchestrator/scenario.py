@@ -139,7 +139,9 @@ class _Loader:
         except ValueError as exc:
             raise self.fail(key, f"{exc} (expected a value in {unit})") from None
 
-    def string(self, node: dict[str, Any], key: str, dotted: str, default: str | None = None) -> str:
+    def string(
+        self, node: dict[str, Any], key: str, dotted: str, default: str | None = None
+    ) -> str:
         if key not in node:
             if default is None:
                 raise self.fail(dotted, "missing; expected a string")
@@ -167,7 +169,9 @@ class _Loader:
         fmus = self.fmus(self.table(raw["fmus"], "fmus"))
         connections = self.connections(raw.get("connections", []), fmus)
         master = self.master(self.table(raw["master"], "master"), fmus, stop - start)
-        record, every, out_dir = self.output(self.table(raw.get("output", {}), "output"), fmus, name)
+        record, every, out_dir = self.output(
+            self.table(raw.get("output", {}), "output"), fmus, name
+        )
         headline, analysis, options = self.report(self.table(raw.get("report", {}), "report"), fmus)
         return Scene(
             path=self.path,
@@ -196,7 +200,9 @@ class _Loader:
             self.check_keys(entry, key, {"component", "parameters", "inputs"})
             fmu = self.string(entry, "component", f"{key}.component")
             if fmu not in FMU_WRAPPERS:
-                raise self.fail(f"{key}.component", f"unknown {fmu!r}; expected one of {sorted(FMU_WRAPPERS)}")
+                raise self.fail(
+                    f"{key}.component", f"unknown {fmu!r}; expected one of {sorted(FMU_WRAPPERS)}"
+                )
             cls = component_class(fmu)
             params = self.values(entry.get("parameters", {}), f"{key}.parameters", cls, "parameter")
             inputs = self.values(entry.get("inputs", {}), f"{key}.inputs", cls, "input")
@@ -207,9 +213,13 @@ class _Loader:
         node = self.table(node, key)
         declared = {v.name: v for v in cls.variables(causality)}  # type: ignore[arg-type]
         self.check_keys(node, key, set(declared))
-        return {name: self.quantity(v, f"{key}.{name}", declared[name].unit) for name, v in node.items()}
+        return {
+            name: self.quantity(v, f"{key}.{name}", declared[name].unit) for name, v in node.items()
+        }
 
-    def signal(self, text: Any, key: str, fmus: dict[str, FmuSpec], causality: str | None) -> tuple[str, str]:
+    def signal(
+        self, text: Any, key: str, fmus: dict[str, FmuSpec], causality: str | None
+    ) -> tuple[str, str]:
         if not isinstance(text, str) or text.count(".") != 1:
             raise self.fail(key, f"expected '<instance>.<variable>', got {text!r}")
         instance, var = text.split(".")
@@ -220,7 +230,8 @@ class _Loader:
         if var not in names or (causality and names[var].causality != causality):
             wanted = [v.name for v in cls.VARIABLES if not causality or v.causality == causality]
             kind = f"{causality} " if causality else ""
-            raise self.fail(key, f"{instance!r} ({fmus[instance].fmu}) has no {kind}variable {var!r}; expected one of {wanted}")
+            owner = f"{instance!r} ({fmus[instance].fmu})"
+            raise self.fail(key, f"{owner} has no {kind}variable {var!r}; expected one of {wanted}")
         return instance, var
 
     def connections(self, node: Any, fmus: dict[str, FmuSpec]) -> tuple[Connection, ...]:
@@ -237,27 +248,37 @@ class _Loader:
                 self.check_keys(entry, key, {"from", "to"})
                 for side in ("from", "to"):
                     if side not in entry:
-                        raise self.fail(f"{key}.{side}", "missing; expected '<instance>.<variable>'")
+                        raise self.fail(
+                            f"{key}.{side}", "missing; expected '<instance>.<variable>'"
+                        )
                 src = self.signal(entry["from"], f"{key}.from", fmus, "output")
                 dst = self.signal(entry["to"], f"{key}.to", fmus, "input")
                 result.append(Connection(src, dst))
         targets = [c.target for c in result]
         for t in targets:
             if targets.count(t) > 1:
-                raise self.fail("connections", f"input {'.'.join(t)} is driven by more than one output")
+                raise self.fail(
+                    "connections", f"input {'.'.join(t)} is driven by more than one output"
+                )
         return tuple(result)
 
     def port_connection(self, ports: Any, key: str, fmus: dict[str, FmuSpec]) -> list[Connection]:
-        if not (isinstance(ports, list) and len(ports) == 2 and all(isinstance(p, str) for p in ports)):
+        if not (
+            isinstance(ports, list) and len(ports) == 2 and all(isinstance(p, str) for p in ports)
+        ):
             raise self.fail(key, "expected two ports, e.g. ['train.escape_wheel', 'verge.wheel']")
         sides = []
         for port in ports:
             if port.count(".") != 1 or port.split(".")[0] not in fmus:
-                raise self.fail(key, f"expected '<instance>.<port>' with a known instance, got {port!r}")
+                raise self.fail(
+                    key, f"expected '<instance>.<port>' with a known instance, got {port!r}"
+                )
             instance, name = port.split(".")
             cls = component_class(fmus[instance].fmu)
             if name not in cls.PORTS:
-                raise self.fail(key, f"{instance!r} has no port {name!r}; expected one of {sorted(cls.PORTS)}")
+                raise self.fail(
+                    key, f"{instance!r} has no port {name!r}; expected one of {sorted(cls.PORTS)}"
+                )
             sides.append((instance, cls, cls.PORTS[name]))
         (ia, ca, pa), (ib, cb, pb) = sides
         roles = sorted(set(pa) & set(pb))
@@ -271,7 +292,9 @@ class _Loader:
             elif vb.causality == "output" and va.causality == "input":
                 out.append(Connection((ib, vb.name), (ia, va.name)))
             else:
-                raise self.fail(key, f"role {role!r}: one side must output it and the other take it as input")
+                raise self.fail(
+                    key, f"role {role!r}: one side must output it and the other take it as input"
+                )
         return out
 
     def master(self, node: dict[str, Any], fmus: dict[str, FmuSpec], duration: float) -> MasterSpec:
@@ -281,7 +304,9 @@ class _Loader:
                 raise self.fail(f"master.{k}", "missing")
         algorithm = self.string(node, "algorithm", "master.algorithm")
         if algorithm not in ALGORITHMS:
-            raise self.fail("master.algorithm", f"unknown {algorithm!r}; expected one of {list(ALGORITHMS)}")
+            raise self.fail(
+                "master.algorithm", f"unknown {algorithm!r}; expected one of {list(ALGORITHMS)}"
+            )
         step = self.quantity(node["step"], "master.step", "s")
         if not step > 0.0:
             raise self.fail("master.step", f"must be positive, got {step} s")
@@ -338,7 +363,9 @@ class _Loader:
             signal = self.signal(entry["signal"], f"{key}.signal", fmus, None)
             reduce = entry.get("reduce", "final")
             if reduce not in REDUCTIONS:
-                raise self.fail(f"{key}.reduce", f"unknown {reduce!r}; expected one of {list(REDUCTIONS)}")
+                raise self.fail(
+                    f"{key}.reduce", f"unknown {reduce!r}; expected one of {list(REDUCTIONS)}"
+                )
             unit = component_class(fmus[signal[0]].fmu).variable(signal[1]).unit
             headline[hname] = HeadlineSpec(signal, reduce, unit)
         analysis = node.get("analysis")
@@ -346,6 +373,8 @@ class _Loader:
             from orchestrator.analyses import ANALYSES
 
             if analysis not in ANALYSES:
-                raise self.fail("report.analysis", f"unknown {analysis!r}; expected one of {sorted(ANALYSES)}")
+                raise self.fail(
+                    "report.analysis", f"unknown {analysis!r}; expected one of {sorted(ANALYSES)}"
+                )
         options = self.table(node.get("options", {}), "report.options")
         return headline, analysis, dict(options)
