@@ -65,7 +65,9 @@ def _column(header: list[str], data: np.ndarray, name: str) -> np.ndarray:
     return data[:, header.index(name)]
 
 
-def two_inertias(scene: Scene, header: list[str], data: np.ndarray, options: dict[str, Any]) -> dict[str, Any]:
+def two_inertias(
+    scene: Scene, header: list[str], data: np.ndarray, options: dict[str, Any]
+) -> dict[str, Any]:
     """Coupling error of the two-inertia scene against its closed form."""
     a, b = options.get("body_a", "a"), options.get("body_b", "b")
     pa, pb = scene.fmus[a].parameters, scene.fmus[b].parameters
@@ -88,7 +90,10 @@ def two_inertias(scene: Scene, header: list[str], data: np.ndarray, options: dic
     err_b = _column(header, data, f"{b}.phi") - exact["phi_b"]
     twist_scale = max(float(np.max(np.abs(exact["phi_a"] - exact["phi_b"]))), 1e-300)
     return {
-        "max_angle_error": {"value": float(max(np.max(np.abs(err_a)), np.max(np.abs(err_b)))), "unit": "rad"},
+        "max_angle_error": {
+            "value": float(max(np.max(np.abs(err_a)), np.max(np.abs(err_b)))),
+            "unit": "rad",
+        },
         "final_angle_error_a": {"value": float(abs(err_a[-1])), "unit": "rad"},
         "relative_twist_error": {
             "value": float(np.max(np.abs(err_a - err_b)) / twist_scale),

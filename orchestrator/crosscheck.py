@@ -20,7 +20,10 @@ def run_with_libcosim(scene: Scene, cache_dir: Path | None = None) -> tuple[list
     """Recorded Real signals after each of libcosim's fixed steps (the start row is absent)."""
     paths = {spec.fmu: str(build_fmu(spec.fmu, cache_dir)) for spec in scene.fmus.values()}
     job = {
-        "fmus": [(name, paths[spec.fmu], spec.parameters, spec.inputs) for name, spec in scene.fmus.items()],
+        "fmus": [
+            (name, paths[spec.fmu], spec.parameters, spec.inputs)
+            for name, spec in scene.fmus.items()
+        ],
         "connections": [(c.source, c.target) for c in scene.connections],
         "record": list(scene.record),
         "step_ns": round(scene.master.step * 1e9),

@@ -19,7 +19,12 @@ def check_fmu(name: str, cache_dir: Path | None = None) -> list[str]:
     if md.defaultExperiment is None:
         problems.append("no DefaultExperiment")
     for v in md.modelVariables:
-        if v.type == "Real" and v.causality != "local" and v.unit is None and not _dimensionless(name, v.name):
+        if (
+            v.type == "Real"
+            and v.causality != "local"
+            and v.unit is None
+            and not _dimensionless(name, v.name)
+        ):
             problems.append(f"variable {v.name!r} declares no unit")
     try:
         result = simulate_fmu(str(path))
@@ -62,7 +67,9 @@ def state_round_trip_problems(path: Path, steps: int = 20, h: float = 1e-4) -> l
     return []
 
 
-def _advance(fmu: FmuInstance, t: float, h: float, steps: int, real_refs: list[int], int_refs: list[int]):
+def _advance(
+    fmu: FmuInstance, t: float, h: float, steps: int, real_refs: list[int], int_refs: list[int]
+):
     trace = []
     for _ in range(steps):
         fmu.do_step(t, h)

@@ -15,17 +15,17 @@ from typing import Any
 
 from fmpy import extract, read_model_description
 from fmpy.fmi1 import FMICallException
-from fmpy.fmi2 import (
+from fmpy.fmi2 import (  # the allocators fmpy itself hands to FMUs
     FMU2Slave,
+    calloc,
     fmi2CallbackAllocateMemoryTYPE,
     fmi2CallbackFreeMemoryTYPE,
     fmi2CallbackFunctions,
     fmi2CallbackLoggerTYPE,
+    free,
 )
-from fmpy.fmi2 import calloc, free  # the allocators fmpy itself hands to FMUs
 
 from orchestrator.errors import RunError
-
 
 _UNPACKED: dict[str, tuple[Any, str]] = {}
 
@@ -96,7 +96,9 @@ class FmuInstance:
                     self.fmu.setReal(self.refs([name]), [value])
             self.fmu.exitInitializationMode()
         except FMICallException as exc:
-            raise RunError(f"initialization failed: {self.last_message() or exc}", start, self.name) from None
+            raise RunError(
+                f"initialization failed: {self.last_message() or exc}", start, self.name
+            ) from None
 
     def do_step(self, t: float, h: float) -> None:
         try:

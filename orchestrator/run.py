@@ -97,7 +97,9 @@ def run_scene(
     if residual is not None:
         quantities["energy_residual"] = residual
     if scene.analysis and status == "completed":
-        quantities.update(ANALYSES[scene.analysis](scene, recorder.header, data, scene.analysis_options))
+        quantities.update(
+            ANALYSES[scene.analysis](scene, recorder.header, data, scene.analysis_options)
+        )
     recorder.close(
         {
             "scene": scene.name,
@@ -108,7 +110,9 @@ def run_scene(
             "metadata": meta,
         }
     )
-    return RunResult(scene, status, message, recorder.header, data, recorder.events, stats, quantities, out, meta)
+    return RunResult(
+        scene, status, message, recorder.header, data, recorder.events, stats, quantities, out, meta
+    )
 
 
 def _metadata(scene: Scene, fmu_paths: dict[str, Path]) -> dict[str, Any]:

@@ -51,8 +51,12 @@ class CoupledSystem:
                 self.record_slots.append((i, "int", len(self.int_names[i]) - 1))
             else:
                 self.record_slots.append((i, "real", self._read_slot(inst, var)))
-        self.read_refs = [inst.refs(names) for inst, names in zip(self.instances, self.read_names, strict=True)]
-        self.int_refs = [inst.refs(names) for inst, names in zip(self.instances, self.int_names, strict=True)]
+        self.read_refs = [
+            inst.refs(names) for inst, names in zip(self.instances, self.read_names, strict=True)
+        ]
+        self.int_refs = [
+            inst.refs(names) for inst, names in zip(self.instances, self.int_names, strict=True)
+        ]
         self.feeds: list[_Feed] = [_Feed([], []) for _ in self.names]
         for c in scene.connections:
             src, dst = self.index[c.source[0]], self.index[c.target[0]]

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import re
-from functools import lru_cache
+from functools import cache
 
 import pint
 
@@ -11,7 +11,7 @@ UREG = pint.UnitRegistry()
 _POWER = re.compile(r"([A-Za-z]+)(-?\d+)")
 
 
-@lru_cache(maxsize=None)
+@cache
 def pint_unit(fmi_unit: str) -> pint.Unit:
     """'N.m.s/rad' -> N*m*s/rad, 'kg.m2' -> kg*m**2, '1' -> dimensionless."""
     if fmi_unit == "1":

@@ -58,13 +58,20 @@ def test_good_scene_loads_with_si_values(tmp_path: Path) -> None:
 
 
 def test_unknown_key(tmp_path: Path) -> None:
-    expect_error(write(tmp_path, GOOD.replace('stop = "0.01 s"', 'stop = "0.01 s"\nstpo = 1')),
-                 "scene.stpo", "unknown key")
+    expect_error(
+        write(tmp_path, GOOD.replace('stop = "0.01 s"', 'stop = "0.01 s"\nstpo = 1')),
+        "scene.stpo",
+        "unknown key",
+    )
 
 
 def test_unknown_parameter(tmp_path: Path) -> None:
-    expect_error(write(tmp_path, GOOD.replace('w0 = "10 rad/s"', 'omega = "10 rad/s"')),
-                 "fmus.a.parameters.omega", "unknown key", "'w0'")
+    expect_error(
+        write(tmp_path, GOOD.replace('w0 = "10 rad/s"', 'omega = "10 rad/s"')),
+        "fmus.a.parameters.omega",
+        "unknown key",
+        "'w0'",
+    )
 
 
 def test_missing_required_value(tmp_path: Path) -> None:
@@ -72,13 +79,20 @@ def test_missing_required_value(tmp_path: Path) -> None:
 
 
 def test_wrong_unit(tmp_path: Path) -> None:
-    expect_error(write(tmp_path, GOOD.replace('"2e-4 kg*m^2"', '"2 in"')),
-                 "fmus.a.parameters.J", "cannot be converted to kg.m2")
+    expect_error(
+        write(tmp_path, GOOD.replace('"2e-4 kg*m^2"', '"2 in"')),
+        "fmus.a.parameters.J",
+        "cannot be converted to kg.m2",
+    )
 
 
 def test_connection_to_missing_port(tmp_path: Path) -> None:
-    expect_error(write(tmp_path, GOOD.replace('"b.coupling"', '"b.shaft"')),
-                 "connections[0].ports", "no port 'shaft'", "coupling")
+    expect_error(
+        write(tmp_path, GOOD.replace('"b.coupling"', '"b.shaft"')),
+        "connections[0].ports",
+        "no port 'shaft'",
+        "coupling",
+    )
 
 
 def test_connection_to_missing_variable(tmp_path: Path) -> None:
@@ -87,13 +101,19 @@ def test_connection_to_missing_variable(tmp_path: Path) -> None:
 
 
 def test_negative_step(tmp_path: Path) -> None:
-    expect_error(write(tmp_path, GOOD.replace('step = "1 ms"', 'step = "-1 ms"')),
-                 "master.step", "must be positive")
+    expect_error(
+        write(tmp_path, GOOD.replace('step = "1 ms"', 'step = "-1 ms"')),
+        "master.step",
+        "must be positive",
+    )
 
 
 def test_unknown_component(tmp_path: Path) -> None:
-    expect_error(write(tmp_path, GOOD.replace('"Inertia"', '"Flywheel"')),
-                 "fmus.a.component", "unknown 'Flywheel'")
+    expect_error(
+        write(tmp_path, GOOD.replace('"Inertia"', '"Flywheel"')),
+        "fmus.a.component",
+        "unknown 'Flywheel'",
+    )
 
 
 def test_not_toml(tmp_path: Path) -> None:

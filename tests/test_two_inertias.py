@@ -15,7 +15,6 @@ from orchestrator.references.two_inertias import two_inertias_exact
 from orchestrator.run import run_scene
 from orchestrator.scenario import load_scene
 
-
 SCENE = Path(__file__).resolve().parent.parent / "scenarios" / "two_inertias.toml"
 
 
@@ -29,7 +28,9 @@ def test_closed_form_conserves_momentum_and_oscillates() -> None:
     x = two_inertias_exact(t, 2e-4, 1e-4, 2.0, 0.0, w_a0=10.0)
     momentum = 2e-4 * x["w_a"] + 1e-4 * x["w_b"]
     assert np.allclose(momentum, 2e-3, rtol=0, atol=1e-15)
-    energy = 0.5 * 2e-4 * x["w_a"] ** 2 + 0.5 * 1e-4 * x["w_b"] ** 2 + (x["phi_a"] - x["phi_b"]) ** 2
+    energy = (
+        0.5 * 2e-4 * x["w_a"] ** 2 + 0.5 * 1e-4 * x["w_b"] ** 2 + (x["phi_a"] - x["phi_b"]) ** 2
+    )
     assert np.allclose(energy, 0.5 * 2e-4 * 100.0, rtol=1e-12)
     # twist frequency sqrt(k / J_reduced)
     period = 2 * math.pi / math.sqrt(2.0 / (2e-4 * 1e-4 / 3e-4))

@@ -22,7 +22,14 @@ def _grid(scene: Scene) -> tuple[int, float]:
     return n, h
 
 
-def _run(system: CoupledSystem, scene: Scene, recorder: Recorder, stats: StepStats, progress, sequential: bool) -> None:
+def _run(
+    system: CoupledSystem,
+    scene: Scene,
+    recorder: Recorder,
+    stats: StepStats,
+    progress,
+    sequential: bool,
+) -> None:
     n, h = _grid(scene)
     m = len(system.instances)
     every = scene.record_every
@@ -48,9 +55,13 @@ def _run(system: CoupledSystem, scene: Scene, recorder: Recorder, stats: StepSta
         progress(t)
 
 
-def run_jacobi(system: CoupledSystem, scene: Scene, recorder: Recorder, stats: StepStats, progress) -> None:
+def run_jacobi(
+    system: CoupledSystem, scene: Scene, recorder: Recorder, stats: StepStats, progress
+) -> None:
     _run(system, scene, recorder, stats, progress, sequential=False)
 
 
-def run_gauss_seidel(system: CoupledSystem, scene: Scene, recorder: Recorder, stats: StepStats, progress) -> None:
+def run_gauss_seidel(
+    system: CoupledSystem, scene: Scene, recorder: Recorder, stats: StepStats, progress
+) -> None:
     _run(system, scene, recorder, stats, progress, sequential=True)
