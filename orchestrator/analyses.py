@@ -11,7 +11,6 @@ from typing import Any
 
 import numpy as np
 
-from orchestrator.references.two_inertias import two_inertias_exact
 from orchestrator.scenario import Scene
 
 _REDUCE: dict[str, Callable[[np.ndarray], float]] = {
@@ -65,43 +64,4 @@ def _column(header: list[str], data: np.ndarray, name: str) -> np.ndarray:
     return data[:, header.index(name)]
 
 
-def two_inertias(
-    scene: Scene, header: list[str], data: np.ndarray, options: dict[str, Any]
-) -> dict[str, Any]:
-    """Coupling error of the two-inertia scene against its closed form."""
-    a, b = options.get("body_a", "a"), options.get("body_b", "b")
-    pa, pb = scene.fmus[a].parameters, scene.fmus[b].parameters
-    defaults_a = {v.name: v.start for v in scene.component_class(a).VARIABLES}
-    defaults_b = {v.name: v.start for v in scene.component_class(b).VARIABLES}
-    par_a, par_b = {**defaults_a, **pa}, {**defaults_b, **pb}
-    t = _column(header, data, "time")
-    exact = two_inertias_exact(
-        t - scene.start,
-        par_a["J"],
-        par_b["J"],
-        par_b["k"],
-        par_b["d"],
-        par_a["phi0"],
-        par_a["w0"],
-        par_b["phi0"],
-        par_b["w0"],
-    )
-    err_a = _column(header, data, f"{a}.phi") - exact["phi_a"]
-    err_b = _column(header, data, f"{b}.phi") - exact["phi_b"]
-    twist_scale = max(float(np.max(np.abs(exact["phi_a"] - exact["phi_b"]))), 1e-300)
-    return {
-        "max_angle_error": {
-            "value": float(max(np.max(np.abs(err_a)), np.max(np.abs(err_b)))),
-            "unit": "rad",
-        },
-        "final_angle_error_a": {"value": float(abs(err_a[-1])), "unit": "rad"},
-        "relative_twist_error": {
-            "value": float(np.max(np.abs(err_a - err_b)) / twist_scale),
-            "unit": "1",
-        },
-    }
-
-
-ANALYSES: dict[str, Callable[..., dict[str, Any]]] = {
-    "two_inertias": two_inertias,
-}
+ANALYSES: dict[str, Callable[..., dict[str, Any]]] = {}

@@ -90,6 +90,8 @@ def _run(args: argparse.Namespace) -> int:
     )
     for name, q in result.headline.items():
         print(f"  {name:32s} {q['value']:.10g} {q['unit']}")
+    for name, value in result.accuracy.items():
+        print(f"  {name:32s} {value:.4g}")
     s = result.stats
     print(
         f"  steps {s.steps}, doSteps {s.do_steps}, rejections {s.rejections}, "

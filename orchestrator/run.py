@@ -19,11 +19,13 @@ import numpy as np
 from tqdm import tqdm
 
 from fmus.build import build_fmu
+from orchestrator.accuracy import compare
 from orchestrator.analyses import ANALYSES, energy_residual, headline
 from orchestrator.errors import RunError
 from orchestrator.fmu_instance import file_sha256
 from orchestrator.masters import MASTERS
 from orchestrator.recorder import Recorder, StepStats
+from orchestrator.references import REFERENCES, Reference
 from orchestrator.scenario import Scene
 from orchestrator.system import CoupledSystem
 
@@ -41,6 +43,7 @@ class RunResult:
     stats: StepStats
     headline: dict[str, dict[str, Any]]
     output_dir: Path
+    accuracy: dict[str, float] = field(default_factory=dict)
     metadata: dict[str, Any] = field(default_factory=dict)
 
     def signal(self, name: str) -> np.ndarray:
@@ -56,6 +59,7 @@ def run_scene(
     output_dir: Path | None = None,
     cache_dir: Path | None = None,
     show_progress: bool = True,
+    compare_reference: bool = True,
 ) -> RunResult:
     """Run ``scene`` and write its results under ``output_dir`` (default: the scene's)."""
     out = Path(output_dir) if output_dir else scene.output_dir
@@ -100,19 +104,43 @@ def run_scene(
         quantities.update(
             ANALYSES[scene.analysis](scene, recorder.header, data, scene.analysis_options)
         )
+    accuracy: dict[str, float] = {}
+    if scene.reference and status == "completed" and compare_reference:
+        ref = reference_of(scene)
+        accuracy = compare(recorder.header, data, recorder.events, quantities, ref)
+        accuracy["reference_wall_time"] = ref.wall_time
     recorder.close(
         {
             "scene": scene.name,
             "status": status,
             "message": message,
             "headline": quantities,
+            "accuracy": accuracy,
             "stats": stats.as_dict(),
             "metadata": meta,
         }
     )
     return RunResult(
-        scene, status, message, recorder.header, data, recorder.events, stats, quantities, out, meta
+        scene,
+        status,
+        message,
+        recorder.header,
+        data,
+        recorder.events,
+        stats,
+        quantities,
+        out,
+        accuracy,
+        meta,
     )
+
+
+def reference_of(scene: Scene) -> Reference:
+    """The scene's reference, timed (wall_time is filled in)."""
+    start = time.perf_counter()
+    ref = REFERENCES[scene.reference](scene)
+    ref.wall_time = time.perf_counter() - start
+    return ref
 
 
 def _metadata(scene: Scene, fmu_paths: dict[str, Path]) -> dict[str, Any]:

@@ -80,6 +80,7 @@ class Scene:
     headline: dict[str, HeadlineSpec]
     analysis: str | None
     analysis_options: dict[str, Any]
+    reference: str | None = None
 
     def component_class(self, instance: str) -> type[Component]:
         return component_class(self.fmus[instance].fmu)
@@ -172,7 +173,8 @@ class _Loader:
         record, every, out_dir = self.output(
             self.table(raw.get("output", {}), "output"), fmus, name
         )
-        headline, analysis, options = self.report(self.table(raw.get("report", {}), "report"), fmus)
+        report = self.table(raw.get("report", {}), "report")
+        headline, analysis, options, reference = self.report(report, fmus)
         return Scene(
             path=self.path,
             name=name,
@@ -188,6 +190,7 @@ class _Loader:
             headline=headline,
             analysis=analysis,
             analysis_options=options,
+            reference=reference,
         )
 
     def fmus(self, node: dict[str, Any]) -> dict[str, FmuSpec]:
@@ -352,7 +355,7 @@ class _Loader:
         return record, every, Path(directory)
 
     def report(self, node: dict[str, Any], fmus: dict[str, FmuSpec]):
-        self.check_keys(node, "report", {"headline", "analysis", "options"})
+        self.check_keys(node, "report", {"headline", "analysis", "options", "reference"})
         headline: dict[str, HeadlineSpec] = {}
         for hname, entry in self.table(node.get("headline", {}), "report.headline").items():
             key = f"report.headline.{hname}"
@@ -377,4 +380,13 @@ class _Loader:
                     "report.analysis", f"unknown {analysis!r}; expected one of {sorted(ANALYSES)}"
                 )
         options = self.table(node.get("options", {}), "report.options")
-        return headline, analysis, dict(options)
+        reference = node.get("reference")
+        if reference is not None:
+            from orchestrator.references import REFERENCES
+
+            if reference not in REFERENCES:
+                known = sorted(REFERENCES)
+                raise self.fail(
+                    "report.reference", f"unknown {reference!r}; expected one of {known}"
+                )
+        return headline, analysis, dict(options), reference
