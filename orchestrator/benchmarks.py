@@ -67,7 +67,9 @@ def overhead(n: int = 20000) -> dict[str, float]:
             b.step(0.0, 1e-5)
 
     # ... and through the master with the FMUs, recording every step.
-    scene = load_scene(SCENARIOS / "two_inertias.toml", {"master.step": 1e-5, "scene.stop": n * 1e-5})
+    scene = load_scene(
+        SCENARIOS / "two_inertias.toml", {"master.step": 1e-5, "scene.stop": n * 1e-5}
+    )
 
     def master(count: int) -> None:
         run_scene(scene, output_dir=Path("runs") / "bench_overhead", show_progress=False)

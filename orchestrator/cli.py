@@ -50,6 +50,13 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("scene", type=Path)
     p.set_defaults(handler=_crosscheck)
 
+    p = sub.add_parser("precision", help="work–precision report: error against wall time")
+    p.add_argument("scene", type=Path)
+    p.add_argument("--output", type=Path, help="directory (default runs/<scene>_work_precision)")
+    p.add_argument("--workers", type=int, help="local processes (default: one per core)")
+    p.add_argument("--dask", metavar="ADDRESS", help="run the sweep on this Dask scheduler")
+    p.set_defaults(handler=_precision)
+
     p = sub.add_parser("bench", help="run a benchmark (prints ratios against its baseline)")
     p.add_argument("name", choices=["overhead"])
     p.set_defaults(handler=_bench)
@@ -152,6 +159,17 @@ def _crosscheck(args: argparse.Namespace) -> int:
     worst = float(diff[:, 1:].max())
     print(f"largest difference {worst:.3e} over {n} steps of {scene.master.step} s")
     return 0 if worst <= 1e-9 else 1
+
+
+def _precision(args: argparse.Namespace) -> int:
+    from orchestrator.work_precision import observed_order, work_precision
+
+    rows = work_precision(args.scene, args.output, workers=args.workers, dask_address=args.dask)
+    for master in dict.fromkeys(r.master for r in rows):
+        print(f"  {master:14s} observed order {observed_order(rows, master):.2f}")
+    out = Path(rows[0].result.job.output_dir).parent if rows else args.output
+    print(f"report in {out}/work_precision.md (.csv, .png)")
+    return 0
 
 
 def _bench(args: argparse.Namespace) -> int:

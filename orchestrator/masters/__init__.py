@@ -8,3 +8,5 @@ MASTERS = {
     "jacobi": run_jacobi,
     "gauss-seidel": run_gauss_seidel,
 }
+#: Masters whose accuracy is set by master.tolerance rather than by the macro step.
+TOLERANCE_MASTERS: tuple[str, ...] = ()

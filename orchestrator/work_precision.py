@@ -1,0 +1,200 @@
+"""Work–precision report: error against wall time for every master setting of a scene.
+
+One command runs the scene's reference once, then sweeps the masters (fixed-step Jacobi and
+Gauss–Seidel over macro steps; tolerance-driven masters over tolerances) on a process pool
+or a Dask cluster, and writes ``work_precision.csv``, ``work_precision.png`` and
+``work_precision.md`` with the observed convergence order of each master.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from orchestrator.accuracy import compare
+from orchestrator.errors import ScenarioError
+from orchestrator.masters import TOLERANCE_MASTERS
+from orchestrator.run import reference_of
+from orchestrator.scenario import Scene, load_scene
+from orchestrator.sweep import Job, JobResult, run_jobs
+
+STEP_FACTORS = (8.0, 4.0, 2.0, 1.0, 0.5, 0.25)
+TOLERANCES = (1e-2, 1e-3, 1e-4, 1e-5, 1e-6)
+COLUMNS = [
+    "master",
+    "setting",
+    "value",
+    "status",
+    "wall_time",
+    "headline_error",
+    "trajectory_error",
+    "event_time_error",
+    "energy_residual",
+    "steps",
+    "do_steps",
+    "rollbacks",
+    "rejections",
+    "iterations",
+    "events",
+]
+
+
+@dataclass
+class Row:
+    master: str
+    setting: str  # "step" or "tolerance"
+    value: float
+    result: JobResult
+    accuracy: dict[str, float]
+
+    def as_dict(self) -> dict[str, Any]:
+        stats = self.result.stats
+        energy = self.result.headline.get("energy_residual", {}).get("value", math.nan)
+        return {
+            "master": self.master,
+            "setting": self.setting,
+            "value": self.value,
+            "status": self.result.status,
+            "wall_time": stats.get("wall_time", math.nan),
+            "headline_error": self.accuracy.get("headline_error", math.nan),
+            "trajectory_error": self.accuracy.get("trajectory_error", math.nan),
+            "event_time_error": self.accuracy.get("event_time_error", math.nan),
+            "energy_residual": energy,
+            **{k: stats.get(k, 0) for k in COLUMNS[9:]},
+        }
+
+
+def sweep_jobs(
+    scene_path: Path, scene: Scene, out_dir: Path, step_factors, tolerances
+) -> list[Job]:
+    jobs = []
+    for master in ("jacobi", "gauss-seidel"):
+        for f in step_factors:
+            h = scene.master.step * f
+            if h > scene.stop - scene.start:
+                continue
+            overrides = {"master.algorithm": master, "master.step": h}
+            jobs.append(
+                Job(str(scene_path), overrides, str(out_dir / f"{master}_h{h:.3e}"), master)
+            )
+    for master in TOLERANCE_MASTERS:
+        for tol in tolerances:
+            overrides = {"master.algorithm": master, "master.tolerance": tol}
+            jobs.append(
+                Job(str(scene_path), overrides, str(out_dir / f"{master}_tol{tol:.0e}"), master)
+            )
+    return jobs
+
+
+def work_precision(
+    scene_path: Path,
+    out_dir: Path | None = None,
+    step_factors=STEP_FACTORS,
+    tolerances=TOLERANCES,
+    workers: int | None = None,
+    dask_address: str | None = None,
+) -> list[Row]:
+    scene = load_scene(scene_path)
+    if not scene.reference:
+        raise ScenarioError(scene_path, "report.reference", "missing; the report needs a reference")
+    out_dir = Path(out_dir or Path("runs") / f"{scene.name}_work_precision")
+    out_dir.mkdir(parents=True, exist_ok=True)
+    reference = reference_of(scene)
+    jobs = sweep_jobs(scene_path, scene, out_dir, step_factors, tolerances)
+    results = run_jobs(jobs, workers=workers, dask_address=dask_address)
+    rows = []
+    for job, res in zip(jobs, results, strict=True):
+        accuracy = {}
+        if res.status == "completed":
+            accuracy = compare(res.header, res.data, res.events, res.headline, reference)
+        setting, value = (
+            ("tolerance", job.overrides["master.tolerance"])
+            if "master.tolerance" in job.overrides
+            else ("step", job.overrides["master.step"])
+        )
+        rows.append(Row(job.label, setting, value, res, accuracy))
+    _write_csv(rows, out_dir / "work_precision.csv")
+    _plot(rows, reference.wall_time, scene.name, out_dir / "work_precision.png")
+    _write_summary(rows, scene, reference.wall_time, out_dir / "work_precision.md")
+    return rows
+
+
+def observed_order(rows: list[Row], master: str, error: str = "trajectory_error") -> float:
+    """Least-squares slope of log(error) against log(setting) for one master."""
+    pts = [
+        (r.value, r.accuracy.get(error, math.nan))
+        for r in rows
+        if r.master == master and r.result.status == "completed"
+    ]
+    pts = [(x, y) for x, y in pts if y > 0 and math.isfinite(y)]
+    if len(pts) < 2:
+        return math.nan
+    x, y = np.log([p[0] for p in pts]), np.log([p[1] for p in pts])
+    return float(np.polyfit(x, y, 1)[0])
+
+
+def _write_csv(rows: list[Row], path: Path) -> None:
+    with open(path, "w", newline="") as f:
+        writer = csv.DictWriter(f, fieldnames=COLUMNS)
+        writer.writeheader()
+        for r in rows:
+            writer.writerow(r.as_dict())
+
+
+def _plot(rows: list[Row], reference_time: float, name: str, path: Path) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.5))
+    for ax, error in zip(axes, ("trajectory_error", "headline_error"), strict=True):
+        for master in dict.fromkeys(r.master for r in rows):
+            pts = [
+                (r.result.stats["wall_time"], r.accuracy.get(error, math.nan))
+                for r in rows
+                if r.master == master and r.result.status == "completed"
+            ]
+            pts = sorted((x, y) for x, y in pts if y > 0 and math.isfinite(y))
+            if pts:
+                ax.loglog(*zip(*pts, strict=True), "o-", label=master)
+        if reference_time > 0:
+            ax.axvline(reference_time, color="grey", ls=":", label="reference run time")
+        ax.set_xlabel("wall time [s]")
+        ax.set_ylabel(error.replace("_", " ") + " (relative)")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend()
+    fig.suptitle(f"{name}: work–precision")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def _write_summary(rows: list[Row], scene: Scene, reference_time: float, path: Path) -> None:
+    lines = [
+        f"# Work–precision: {scene.name}",
+        "",
+        f"Reference: `{scene.reference}` ({reference_time:.3g} s). "
+        f"{len(rows)} runs; errors are relative to the reference.",
+        "",
+        "| master | setting | value | status | wall time [s] | headline error | trajectory error "
+        "| energy residual | doSteps | rollbacks |",
+        "|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    for r in rows:
+        d = r.as_dict()
+        lines.append(
+            f"| {d['master']} | {d['setting']} | {d['value']:.3g} | {d['status']} "
+            f"| {d['wall_time']:.3g} | {d['headline_error']:.3g} | {d['trajectory_error']:.3g} "
+            f"| {d['energy_residual']:.3g} | {d['do_steps']} | {d['rollbacks']} |"
+        )
+    lines += ["", "Observed order (slope of log trajectory error against log setting):", ""]
+    for master in dict.fromkeys(r.master for r in rows):
+        setting = next(r.setting for r in rows if r.master == master)
+        lines.append(f"- {master}: {observed_order(rows, master):.2f} (per {setting})")
+    path.write_text("\n".join(lines) + "\n")

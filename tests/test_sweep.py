@@ -1,0 +1,49 @@
+"""Sweeps run in parallel give the same numbers on a process pool and on a Dask cluster."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from orchestrator.sweep import Job, run_jobs
+from orchestrator.work_precision import observed_order, work_precision
+
+SCENE = Path(__file__).resolve().parent.parent / "scenarios" / "two_inertias.toml"
+
+
+def jobs(tmp_path: Path, tag: str) -> list[Job]:
+    return [
+        Job(str(SCENE), {"master.step": h, "scene.stop": "0.05 s"}, str(tmp_path / f"{tag}{h}"))
+        for h in (2e-4, 1e-4, 5e-5)
+    ]
+
+
+def test_pool_and_dask_give_identical_results(tmp_path: Path, fmu_cache, monkeypatch) -> None:
+    pytest.importorskip("dask.distributed")
+    from dask.distributed import LocalCluster
+
+    monkeypatch.setenv("MECHCOSIM_FMU_CACHE", str(fmu_cache))
+    local = run_jobs(jobs(tmp_path, "pool"), workers=2)
+    with LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+    ) as cluster:
+        remote = run_jobs(jobs(tmp_path, "dask"), dask_address=cluster.scheduler_address)
+    assert [r.status for r in local] == ["completed"] * 3
+    for a, b in zip(local, remote, strict=True):
+        assert a.header == b.header
+        assert np.array_equal(a.data, b.data)
+        assert a.headline == b.headline
+
+
+def test_work_precision_report_for_the_two_inertias(tmp_path: Path, fmu_cache, monkeypatch) -> None:
+    monkeypatch.setenv("MECHCOSIM_FMU_CACHE", str(fmu_cache))
+    rows = work_precision(SCENE, tmp_path / "wp", step_factors=(4.0, 2.0, 1.0), workers=2)
+    assert len(rows) == 6 and all(r.result.status == "completed" for r in rows)
+    for master in ("jacobi", "gauss-seidel"):
+        assert observed_order(rows, master) == pytest.approx(1.0, abs=0.15)
+    for name in ("work_precision.csv", "work_precision.png", "work_precision.md"):
+        assert (tmp_path / "wp" / name).stat().st_size > 0
+    text = (tmp_path / "wp" / "work_precision.md").read_text()
+    assert "Observed order" in text and "jacobi" in text
