@@ -1,0 +1,117 @@
+"""Roller shaft with the referred strip inertia and a dry-friction brake (note §1.5).
+
+The brake and table friction are one constant torque T_b (static = kinetic).  State machine:
+
+* STICK: the shaft is held, speed exactly 0 (no creep), while |T| <= T_b;
+* SLIP_FORWARD / SLIP_BACKWARD: J theta5'' = T - T_b sign(theta5').
+
+Slip ends when the speed reaches zero; the shaft then sticks if |T| <= T_b (no chattering:
+a stuck shaft leaves only when the applied torque exceeds T_b).  With the input torque held
+over a step the motion is a piecewise parabola, so the step is exact, including the stop.
+"""
+
+from __future__ import annotations
+
+import math
+
+from components.base import COMMON_OUTPUTS, Component, ComponentError, Variable
+from components.press_feed_data import APP_H_J_O5, LBF_IN, ROLLER_RADIUS
+
+REGIME_STICK = 0
+REGIME_SLIP_FORWARD = 1
+REGIME_SLIP_BACKWARD = 2
+
+
+def slip_direction(torque: float, brake_torque: float) -> int:
+    """Regime a stuck shaft goes to under a torque (break-away test, static friction)."""
+    if torque > brake_torque:
+        return REGIME_SLIP_FORWARD
+    if torque < -brake_torque:
+        return REGIME_SLIP_BACKWARD
+    return REGIME_STICK
+
+
+def shaft_acceleration(regime: int, torque: float, brake_torque: float, j: float) -> float:
+    """theta5'' in a given regime (zero while stuck)."""
+    if regime == REGIME_SLIP_FORWARD:
+        return (torque - brake_torque) / j
+    if regime == REGIME_SLIP_BACKWARD:
+        return (torque + brake_torque) / j
+    return 0.0
+
+
+def breakaway_margin(torque: float, brake_torque: float) -> float:
+    """Event indicator while stuck: positive once |T| exceeds the friction torque."""
+    return abs(torque) - brake_torque
+
+
+class BrakeLoad(Component):
+    """Roller shaft + strip + constant dry friction; input: the clutch torque."""
+
+    VARIABLES = (
+        Variable("j", "parameter", "kg.m2", APP_H_J_O5, "shaft + referred strip inertia J_o5"),
+        Variable("brake_torque", "parameter", "N.m", 160.0 * LBF_IN, "friction torque T_b"),
+        Variable("roller_radius", "parameter", "m", ROLLER_RADIUS, "feed roller radius"),
+        Variable("angle0", "parameter", "rad", 0.0, "initial angle (forward positive)"),
+        Variable("speed0", "parameter", "rad/s", 0.0, "initial speed"),
+        Variable("torque", "input", "N.m", 0.0, "torque from the clutch (forward positive)"),
+        Variable("angle", "output", "rad", 0.0, "inner race / roller angle, forward positive"),
+        Variable("speed", "output", "rad/s", 0.0, "roller speed; zero while slipping = stop"),
+        Variable("feed_length", "output", "m", 0.0, "strip advance since start"),
+        Variable("breakaway", "output", "N.m", 0.0, "|torque| - T_b; zero while stuck = slip"),
+        Variable("input_work", "output", "J", 0.0, "work done by the input torque"),
+        Variable("event_time", "output", "s", -1.0, "time of the last stop (slip -> stick)"),
+        *COMMON_OUTPUTS,
+    )
+
+    def initialize(self, t0: float) -> None:
+        if self.j <= 0.0 or self.brake_torque < 0.0:
+            raise ComponentError("BrakeLoad: need j > 0 and brake_torque >= 0")
+        self.angle, self.speed = self.angle0, self.speed0
+        if self.speed > 0.0:
+            self.regime = REGIME_SLIP_FORWARD
+        elif self.speed < 0.0:
+            self.regime = REGIME_SLIP_BACKWARD
+        else:
+            self.regime = slip_direction(self.torque, self.brake_torque)
+        self.input_work = self.dissipated_work = 0.0
+        self.update_outputs()
+
+    def update_outputs(self) -> None:
+        self.feed_length = self.roller_radius * (self.angle - self.angle0)
+        self.breakaway = breakaway_margin(self.torque, self.brake_torque)
+        self.stored_energy = 0.5 * self.j * self.speed * self.speed
+
+    def _advance(self, s: float) -> None:
+        """Move along the current regime's parabola for a time s."""
+        a = shaft_acceleration(self.regime, self.torque, self.brake_torque, self.j)
+        d = self.speed * s + 0.5 * a * s * s
+        self.angle += d
+        self.speed += a * s
+        self.input_work += self.torque * d
+        self.dissipated_work += self.brake_torque * abs(d)
+
+    def step(self, t: float, h: float) -> None:
+        left = h
+        for _ in range(3):  # at most: slip, stop, slip the other way
+            if self.regime == REGIME_STICK:
+                self.regime = slip_direction(self.torque, self.brake_torque)
+                if self.regime == REGIME_STICK:
+                    break
+            a = shaft_acceleration(self.regime, self.torque, self.brake_torque, self.j)
+            if self.speed * a < 0.0 and -self.speed / a < left:
+                stop = -self.speed / a
+                self._advance(stop)
+                self.speed = 0.0  # exact stop
+                left -= stop
+                self.event_time = t + (h - left)
+                self.regime = slip_direction(self.torque, self.brake_torque)
+                if self.regime == REGIME_STICK:
+                    break
+                continue
+            self._advance(left)
+            left = 0.0
+            if self.speed == 0.0 and math.fabs(self.torque) <= self.brake_torque:
+                self.regime = REGIME_STICK
+            break
+        self.update_outputs()

@@ -1,0 +1,342 @@
+"""Crank drive, RSSR linkage and elastic bent coupler: the rocker (outer race) motion.
+
+Physics (note §1.3, §2.2): the crank turns at constant speed; the coupler's first bending
+mode q (inverted-cantilever space function, eqs 3-9) is the only elastic DOF and moves the
+rocker by ``phi4e = phi4r(phi1) + F2(phi1) q`` (14).  Eq. (B.15) with P2, P3 dropped:
+
+    M' q'' + c q' + K_e q = rhoA F1 + F2 (T - J_o4 phi4e'')
+
+with ``M' = rhoA[(V2s1 + V2s2 + sin^2 2a) L + P1]`` (19) and T >= 0 the torque the clutch
+transmits (it acts on the rocker in the thesis +phi4 sense, i.e. against the feed stroke).
+Substituting ``phi4e'' = a_r + F2 q''`` moves J_o4 F2^2 into the mass, as in (19).
+
+Ports are forward-positive: ``theta4 = phi4_max - phi4e`` grows on the feed stroke.
+Energy: the crank delivers ``P_in = rhoA F1 q' + (J_o4 phi4e'' - T) v_r`` where
+``v_r = phi1dot (phi4r' + F2' q)``; then dE/dt + c q'^2 = P_in - T theta4' with
+``E = M'q'^2/2 + K_e q^2/2 + J_o4 phi4e'^2/2``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from components.base import COMMON_OUTPUTS, Component, ComponentError, Variable
+from components.press_feed_data import (
+    APP_H_FOURIER,
+    COUPLER_DAMPING_FACTOR,
+    COUPLER_STANDARD,
+    IN,
+    J_O4,
+    LINKAGE_TABLE1,
+    RPM,
+    BentCoupler,
+    RSSRLinkage,
+)
+from components.rssr_kinematics import ExactRSSR, FourierRocker, rocker_extremes
+
+REGIME_RETURN = 0  # rocker moving back (theta4 decreasing)
+REGIME_FORWARD = 1  # rocker on the feed stroke (theta4 increasing)
+
+
+# -- coupler properties (§1.3) -----------------------------------------------------------
+def tube_section(c: BentCoupler) -> tuple[float, float]:
+    """(area, second moment of area) of the tubular coupler."""
+    area = math.pi / 4.0 * (c.d_outer**2 - c.d_inner**2)
+    inertia = math.pi / 64.0 * (c.d_outer**4 - c.d_inner**4)
+    return area, inertia
+
+
+def coupler_stiffness(c: BentCoupler) -> float:
+    """K_e = (pi/2)^4 EI / L^3 from the strain energy (B.4) [N/m]."""
+    return (math.pi / 2.0) ** 4 * c.youngs * tube_section(c)[1] / c.length**3
+
+
+def coupler_rho_a(c: BentCoupler) -> float:
+    """Mass per length; App. G (G.9) adds rho_M = 0.05 M / A for a mass clamped at B.
+
+    The 0.05 is per inch: it stands for 1/[(V2s1 + V2s2 + sin^2 2a) L] = 1/17.67 in.
+    """
+    area = tube_section(c)[0]
+    return c.density * area + 0.05 / IN * c.lumped_mass
+
+
+def coupler_modal_mass(c: BentCoupler) -> float:
+    """M' = rhoA[(V2s1 + V2s2 + sin^2 2a) L + P1] (19), without the rocker term J_o4 F2^2."""
+    c2a = math.cos(2.0 * c.alpha)
+    v2s2 = c2a**2 - (2.0 - 4.0 / math.pi) * c2a + (1.5 - 4.0 / math.pi)  # (B.9-B.14)
+    bracket = (0.5 + v2s2 + math.sin(2.0 * c.alpha) ** 2) * c.length + c.p1
+    return coupler_rho_a(c) * bracket
+
+
+def coupler_damping(c: BentCoupler) -> float:
+    """Modal viscous damping 0.45 L C_co (18.e) [N.s/m]."""
+    return COUPLER_DAMPING_FACTOR * c.length * c.c_co
+
+
+def strain_factors(c: BentCoupler) -> tuple[float, float]:
+    """Outer-fibre strain per unit q at the gauge (63) and at B (maximum) [1/m]."""
+    curv = (c.d_outer / 2.0) * (math.pi / (2.0 * c.length)) ** 2
+    return curv * math.sin(math.pi * c.gauge_x1 / (2.0 * c.length)), curv
+
+
+@dataclass(frozen=True)
+class DriveModel:
+    """Everything the coupler equation needs, in SI; shared with the monolithic reference."""
+
+    omega: float  # crank speed [rad/s]
+    kin: ExactRSSR | FourierRocker
+    m_co: float  # M' [kg]
+    k_e: float  # [N/m]
+    c_e: float  # [N.s/m]
+    j_o4: float  # [kg.m^2]
+    rho_a: float  # multiplies F1 (21) [kg/m]
+    f1: tuple[float, float, float]  # Fourier coefficients of F1/phi1dot^2 [m^2]
+    phi4_max: float  # forward coordinate origin [rad]
+    rigid: bool
+
+
+def coupler_derivatives(
+    m: DriveModel, phi1: float, q: float, qd: float, torque: float, kin: tuple | None = None
+) -> tuple[float, float, float, float, float]:
+    """(q'', theta4, theta4', P_in, P_diss) at one instant; torque = clutch torque T >= 0.
+
+    Time derivatives (not crank-angle).  Implements (B.15) with constant P1, see module doc.
+    """
+    w = m.omega
+    p4, d4, dd4, f2, f2d, f2dd = kin if kin is not None else m.kin(phi1)
+    v_r = w * (d4 + f2d * q)  # part of phi4e' not due to q'
+    a_r = w * w * (dd4 + f2dd * q) + 2.0 * w * f2d * qd  # part of phi4e'' not due to q''
+    if m.rigid:
+        qdd = 0.0
+        f1 = 0.0
+    else:
+        a0, a1, b1 = m.f1
+        f1 = m.rho_a * w * w * (a0 + a1 * math.cos(phi1) + b1 * math.sin(phi1))
+        qdd = (f1 - m.c_e * qd - m.k_e * q + f2 * (torque - m.j_o4 * a_r)) / (
+            m.m_co + m.j_o4 * f2 * f2
+        )
+    phi4e_dd = a_r + f2 * qdd
+    p_in = f1 * qd + (m.j_o4 * phi4e_dd - torque) * v_r
+    theta4 = m.phi4_max - (p4 + f2 * q)
+    theta4_d = -(v_r + f2 * qd)
+    return qdd, theta4, theta4_d, p_in, m.c_e * qd * qd
+
+
+def rocker_motion(
+    m: DriveModel, phi1: float, q: float, qd: float, kin: tuple | None = None
+) -> tuple[float, float]:
+    """(theta4, theta4') of the rocker, forward positive (14)."""
+    p4, d4, _, f2, f2d, _ = kin if kin is not None else m.kin(phi1)
+    return m.phi4_max - (p4 + f2 * q), -(m.omega * (d4 + f2d * q) + f2 * qd)
+
+
+def coupler_energy(m: DriveModel, q: float, qd: float, theta4_d: float) -> float:
+    """Kinetic + strain energy held by the coupler and the rocker [J]."""
+    return 0.5 * m.m_co * qd * qd + 0.5 * m.k_e * q * q + 0.5 * m.j_o4 * theta4_d * theta4_d
+
+
+def build_drive_model(
+    rpm: float,
+    linkage: RSSRLinkage = LINKAGE_TABLE1,
+    coupler: BentCoupler = COUPLER_STANDARD,
+    j_o4: float = J_O4,
+    f1: tuple[float, float, float] = APP_H_FOURIER.f1,
+    f2_const: float | None = None,
+    fourier_phi4: tuple[float, float, float] | None = None,
+    m_e: float | None = None,
+    k_e: float | None = None,
+    c_e: float | None = None,
+    rigid: bool = False,
+    phi4_max: float | None = None,
+) -> DriveModel:
+    """Assemble a DriveModel from data; m_e/k_e/c_e override the geometric values.
+
+    ``m_e`` is the total equivalent mass of (19) including J_o4 F2^2 (App. H prints 0.00632
+    lb.s^2/in); it requires a constant F2.  ``fourier_phi4`` selects the App. H rocker.
+    """
+    exact = ExactRSSR(linkage, coupler.alpha, f2_const)
+    if fourier_phi4 is not None:
+        if f2_const is None:
+            raise ComponentError("the Fourier rocker needs a constant F2")
+        kin: ExactRSSR | FourierRocker = FourierRocker(fourier_phi4, f2_const)
+    else:
+        kin = exact
+    if phi4_max is None:
+        phi4_max = rocker_extremes(exact)[0]
+    m_co = coupler_modal_mass(coupler)
+    if m_e is not None:
+        if f2_const is None:
+            raise ComponentError("an equivalent-mass override needs a constant F2")
+        m_co = m_e - j_o4 * f2_const**2
+    return DriveModel(
+        omega=rpm * RPM,
+        kin=kin,
+        m_co=m_co,
+        k_e=coupler_stiffness(coupler) if k_e is None else k_e,
+        c_e=coupler_damping(coupler) if c_e is None else c_e,
+        j_o4=j_o4,
+        rho_a=coupler_rho_a(coupler),
+        f1=f1,
+        phi4_max=phi4_max,
+        rigid=rigid,
+    )
+
+
+# -- the component ----------------------------------------------------------------------
+_T1 = LINKAGE_TABLE1
+_C = COUPLER_STANDARD
+
+
+class CrankCouplerDrive(Component):
+    """Constant-speed crank, RSSR linkage with elastic bent coupler, rocker = outer race.
+
+    Input ``torque``: the torque the clutch transmits (>= 0); it loads the rocker against
+    the feed stroke.  Internal event: rocker reversal (``speed`` = 0), located exactly;
+    it changes only the reported regime, not the equations.
+    """
+
+    VARIABLES = (
+        Variable("rpm", "parameter", "1", 200.0, "crank speed [rev/min]"),
+        Variable("phi1_0", "parameter", "rad", 0.0, "crank angle at t0 (if start_at_max = 0)"),
+        Variable("start_at_max", "parameter", "1", 1.0, "1: start at the rigid rocker maximum"),
+        Variable("a1", "parameter", "m", _T1.a1, "crank length"),
+        Variable("a3", "parameter", "m", _T1.a3, "coupler chord AC"),
+        Variable("a4", "parameter", "m", _T1.a4, "rocker length"),
+        Variable("s1", "parameter", "m", _T1.s1, "frame offset s1"),
+        Variable("s2", "parameter", "m", _T1.s2, "frame offset s2"),
+        Variable("s3", "parameter", "m", _T1.s3, "frame offset s3"),
+        Variable("alpha", "parameter", "rad", _C.alpha, "coupler half bend angle"),
+        Variable("L", "parameter", "m", _C.length, "coupler section length"),
+        Variable("d_outer", "parameter", "m", _C.d_outer, "coupler tube outer diameter"),
+        Variable("d_inner", "parameter", "m", _C.d_inner, "coupler tube inner diameter"),
+        Variable("youngs", "parameter", "Pa", _C.youngs, "coupler Young's modulus"),
+        Variable("density", "parameter", "kg/m3", _C.density, "coupler density"),
+        Variable("c_co", "parameter", "N.s/m2", _C.c_co, "coupler damping per unit length"),
+        Variable("p1", "parameter", "m", _C.p1, "mean of P1 (B.17)"),
+        Variable("gauge_x1", "parameter", "m", _C.gauge_x1, "strain gauge position from A"),
+        Variable("lumped_mass", "parameter", "kg", 0.0, "mass clamped at B (App. G)"),
+        Variable("j_o4", "parameter", "kg.m2", J_O4, "rocker + clutch input inertia"),
+        Variable("f1_a0", "parameter", "m2", APP_H_FOURIER.f1[0], "F1/phi1dot^2 constant a10"),
+        Variable("f1_a1", "parameter", "m2", APP_H_FOURIER.f1[1], "F1/phi1dot^2 cos term a11"),
+        Variable("f1_b1", "parameter", "m2", APP_H_FOURIER.f1[2], "F1/phi1dot^2 sin term b11"),
+        Variable("f2_const", "parameter", "rad/m", 0.0, "constant F2 (0: F2(phi1) exact)"),
+        Variable("rigid", "parameter", "1", 0.0, "1: rigid coupler (q = 0)"),
+        Variable("max_step", "parameter", "s", 1.0e-4, "largest internal RK4 step"),
+        Variable("torque", "input", "N.m", 0.0, "torque transmitted by the clutch (>= 0)"),
+        Variable("phi1", "output", "rad", 0.0, "crank angle (absolute, unwrapped)"),
+        Variable("angle", "output", "rad", 0.0, "rocker / outer race angle, forward positive"),
+        Variable("speed", "output", "rad/s", 0.0, "rocker speed; zero = rocker reversal"),
+        Variable("q", "output", "m", 0.0, "coupler midpoint deflection (+ = tension)"),
+        Variable("q_dot", "output", "m/s", 0.0, "coupler deflection rate"),
+        Variable("strain", "output", "1", 0.0, "outer-fibre strain at the gauge (63)"),
+        Variable("strain_b", "output", "1", 0.0, "outer-fibre strain at the bend B"),
+        Variable("phi4_max", "output", "rad", 0.0, "thesis phi4 at theta4 = 0"),
+        Variable("input_work", "output", "J", 0.0, "work done by the crank drive"),
+        Variable("event_time", "output", "s", -1.0, "time of the last rocker reversal"),
+        *COMMON_OUTPUTS,
+    )
+
+    def _build(self) -> tuple[DriveModel, BentCoupler]:
+        coupler = BentCoupler(
+            length=self.L,
+            alpha=self.alpha,
+            d_outer=self.d_outer,
+            d_inner=self.d_inner,
+            youngs=self.youngs,
+            density=self.density,
+            c_co=self.c_co,
+            p1=self.p1,
+            gauge_x1=self.gauge_x1,
+            lumped_mass=self.lumped_mass,
+        )
+        linkage = RSSRLinkage(self.a1, self.a3, self.a4, self.s1, self.s2, self.s3)
+        return build_drive_model(
+            self.rpm,
+            linkage,
+            coupler,
+            j_o4=self.j_o4,
+            f1=(self.f1_a0, self.f1_a1, self.f1_b1),
+            f2_const=self.f2_const if self.f2_const > 0.0 else None,
+            rigid=self.rigid > 0.5,
+        ), coupler
+
+    def initialize(self, t0: float) -> None:
+        if self.rpm <= 0.0 or self.max_step <= 0.0:
+            raise ComponentError("CrankCouplerDrive: rpm and max_step must be positive")
+        self._m, coupler = self._build()
+        self._gauge, self._at_b = strain_factors(coupler)
+        exact = ExactRSSR(
+            RSSRLinkage(self.a1, self.a3, self.a4, self.s1, self.s2, self.s3), self.alpha
+        )
+        if self.start_at_max > 0.5:
+            self.phi1_0 = rocker_extremes(exact)[1]
+        self._t0 = t0
+        self._t = t0
+        self.q = self.q_dot = 0.0
+        self.input_work = self.dissipated_work = 0.0
+        self.phi4_max = self._m.phi4_max
+        self.update_outputs()
+        self.regime = REGIME_FORWARD if self.speed >= 0.0 else REGIME_RETURN
+
+    def update_outputs(self) -> None:
+        m = self._m
+        self.phi1 = self.phi1_0 + m.omega * (self._t - self._t0)
+        _, th, thd, _, _ = coupler_derivatives(m, self.phi1, self.q, self.q_dot, self.torque)
+        self.angle, self.speed = th, thd
+        self.strain = self._gauge * self.q
+        self.strain_b = self._at_b * self.q
+        self.stored_energy = coupler_energy(m, self.q, self.q_dot, thd)
+
+    # RK4 on (q, q', W_in, W_diss); the input torque is held over the step.
+    def _rk4(self, t: float, y: tuple[float, float, float, float], h: float):
+        m, trq, p0, w = self._m, self.torque, self.phi1_0, self._m.omega
+        t0 = self._t0
+
+        def f(tt: float, q: float, qd: float):
+            qdd, _, thd, pin, pd = coupler_derivatives(m, p0 + w * (tt - t0), q, qd, trq)
+            return qd, qdd, pin, pd, thd
+
+        q, qd, wi, wd = y
+        k1 = f(t, q, qd)
+        k2 = f(t + 0.5 * h, q + 0.5 * h * k1[0], qd + 0.5 * h * k1[1])
+        k3 = f(t + 0.5 * h, q + 0.5 * h * k2[0], qd + 0.5 * h * k2[1])
+        k4 = f(t + h, q + h * k3[0], qd + h * k3[1])
+        r = h / 6.0
+        return (
+            q + r * (k1[0] + 2 * k2[0] + 2 * k3[0] + k4[0]),
+            qd + r * (k1[1] + 2 * k2[1] + 2 * k3[1] + k4[1]),
+            wi + r * (k1[2] + 2 * k2[2] + 2 * k3[2] + k4[2]),
+            wd + r * (k1[3] + 2 * k2[3] + 2 * k3[3] + k4[3]),
+        )
+
+    def _speed(self, t: float, q: float, qd: float) -> float:
+        m = self._m
+        return coupler_derivatives(m, self.phi1_0 + m.omega * (t - self._t0), q, qd, 0.0)[2]
+
+    def step(self, t: float, h: float) -> None:
+        n = max(1, math.ceil(h / self.max_step - 1e-9))
+        dt = h / n
+        y = (self.q, self.q_dot, self.input_work, self.dissipated_work)
+        s_prev = self._speed(t, y[0], y[1])
+        for i in range(n):
+            ti = t + i * dt
+            y1 = self._rk4(ti, y, dt)
+            s1 = self._speed(ti + dt, y1[0], y1[1])
+            if (s_prev > 0.0 >= s1) or (s_prev < 0.0 <= s1):
+                # Rocker reversal inside this substep: bisect on the substep length.
+                lo, hi = 0.0, dt
+                while hi - lo > 1e-13:
+                    mid = 0.5 * (lo + hi)
+                    ym = self._rk4(ti, y, mid)
+                    sm = self._speed(ti + mid, ym[0], ym[1])
+                    if (sm > 0.0) == (s_prev > 0.0) and sm != 0.0:
+                        lo = mid
+                    else:
+                        hi = mid
+                self.event_time = ti + hi
+                self.regime = REGIME_RETURN if s_prev > 0.0 else REGIME_FORWARD
+            y, s_prev = y1, s1
+        self.q, self.q_dot, self.input_work, self.dissipated_work = y
+        self._t = t + h
+        self.update_outputs()
