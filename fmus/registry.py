@@ -28,5 +28,16 @@ FMU_WRAPPERS: dict[str, FmuWrapper] = {
             "spring_damper_inertia_fmu",
             "components.rotational.SpringDamperInertia",
         ),
+        _wrapper("GearTrain", "gear_train_fmu", "components.gear_train.GearTrain"),
+        _wrapper(
+            "VergeEscapement", "verge_escapement_fmu", "components.verge_escapement.VergeEscapement"
+        ),
+        _wrapper(
+            "CrankCouplerDrive",
+            "crank_coupler_drive_fmu",
+            "components.rssr_coupler.CrankCouplerDrive",
+        ),
+        _wrapper("SpragClutch", "sprag_clutch_fmu", "components.sprag_clutch.SpragClutch"),
+        _wrapper("BrakeLoad", "brake_load_fmu", "components.brake_load.BrakeLoad"),
     )
 }

@@ -11,6 +11,7 @@ from typing import Any
 
 import numpy as np
 
+from orchestrator.lazy import LazyRegistry
 from orchestrator.scenario import Scene
 
 _REDUCE: dict[str, Callable[[np.ndarray], float]] = {
@@ -64,4 +65,18 @@ def _column(header: list[str], data: np.ndarray, name: str) -> np.ndarray:
     return data[:, header.index(name)]
 
 
-ANALYSES: dict[str, Callable[..., dict[str, Any]]] = {}
+#: Scene analyses: (scene, header, data, options) -> {name: {"value", "unit"}}.
+ANALYSES = LazyRegistry(
+    {
+        "m739": "orchestrator.scenes.m739:analyse",
+        "press_feed": "orchestrator.scenes.press_feed:analyse",
+    }
+)
+#: Scene plots, drawn after a completed run when the scene names the analysis:
+#: (scene, header, data, path) -> None, writing a PNG at path.
+PLOTS = LazyRegistry(
+    {
+        "m739": "orchestrator.scenes.m739:plot",
+        "press_feed": "orchestrator.scenes.press_feed:plot",
+    }
+)

@@ -20,7 +20,7 @@ from tqdm import tqdm
 
 from fmus.build import build_fmu
 from orchestrator.accuracy import compare
-from orchestrator.analyses import ANALYSES, energy_residual, headline
+from orchestrator.analyses import ANALYSES, PLOTS, energy_residual, headline
 from orchestrator.errors import RunError
 from orchestrator.fmu_instance import file_sha256
 from orchestrator.masters import MASTERS
@@ -104,6 +104,8 @@ def run_scene(
         quantities.update(
             ANALYSES[scene.analysis](scene, recorder.header, data, scene.analysis_options)
         )
+        if scene.analysis in PLOTS and len(data) > 1:
+            PLOTS[scene.analysis](scene, recorder.header, data, out / f"{scene.name}.png")
     accuracy: dict[str, float] = {}
     if scene.reference and status == "completed" and compare_reference:
         ref = reference_of(scene)

@@ -11,6 +11,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from orchestrator.lazy import LazyRegistry
+
 
 @dataclass
 class Reference:
@@ -22,10 +24,11 @@ class Reference:
     wall_time: float = 0.0
 
 
-def _registry() -> dict[str, Callable[..., Reference]]:
-    from orchestrator.references.two_inertias import two_inertias_reference
-
-    return {"two_inertias": two_inertias_reference}
-
-
-REFERENCES = _registry()
+#: Scene references: (scene) -> Reference.
+REFERENCES = LazyRegistry(
+    {
+        "two_inertias": "orchestrator.references.two_inertias:two_inertias_reference",
+        "m739": "orchestrator.scenes.m739:reference",
+        "press_feed": "orchestrator.scenes.press_feed:reference",
+    }
+)

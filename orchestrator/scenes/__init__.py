@@ -1,0 +1,1 @@
+"""Scene families: what a mechanism's runs report (analysis) and its yardstick (reference)."""
