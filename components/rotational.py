@@ -93,6 +93,8 @@ class SpringDamperInertia(Component):
         m = self._transition.get(h)
         if m is None:
             m = damped_oscillator_transition(self.k / self.J, self.d / self.J, h)
+            if len(self._transition) > 8:  # variable steps: keep the state small
+                self._transition.clear()
             self._transition[h] = m
         y1 = m[0, 0] * y0 + m[0, 1] * v0
         v1 = m[1, 0] * y0 + m[1, 1] * v0

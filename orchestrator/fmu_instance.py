@@ -120,6 +120,9 @@ class FmuInstance:
     def get_integer(self, refs: list[int]) -> list[int]:
         return self.fmu.getInteger(refs)
 
+    def set_integer(self, refs: list[int], values: list[int]) -> None:
+        self.fmu.setInteger(refs, values)
+
     def get(self, name: str) -> float:
         ref = self.refs([name])
         return (self.fmu.getInteger(ref) if self.is_integer(name) else self.fmu.getReal(ref))[0]

@@ -18,7 +18,7 @@ from fmus.registry import FMU_WRAPPERS
 from orchestrator.errors import ScenarioError
 from orchestrator.units import to_si
 
-ALGORITHMS = ("jacobi", "gauss-seidel")
+ALGORITHMS = ("jacobi", "gauss-seidel", "regime-aware")
 REDUCTIONS = ("final", "initial", "max", "min", "maxabs", "mean")
 
 # Master settings: key -> (SI unit or None for a plain value, required?)

@@ -17,10 +17,22 @@ from orchestrator.scenario import Scene
 
 @dataclass
 class _Feed:
-    """Inputs of one instance: (source instance index, index into its read values, input ref)."""
+    """Inputs of one instance: (source instance, slot in its read values) and input refs."""
 
-    sources: list[tuple[int, int]]
-    refs: list[int]
+    real_sources: list[tuple[int, int]]
+    real_refs: list[int]
+    int_sources: list[tuple[int, int]]
+    int_refs: list[int]
+
+
+@dataclass
+class Watch:
+    """What a master watches on one instance: regime, event indicators, last event time."""
+
+    regime: int | None  # slot in the instance's integer values
+    indicators: list[int]  # slots in its real values (outputs named ind_*)
+    indicator_names: list[str]
+    t_event: int | None  # slot in its real values
 
 
 class CoupledSystem:
@@ -37,41 +49,57 @@ class CoupledSystem:
         except Exception:
             self.close()
             raise
-        # Real values read from each instance after every step: connection sources first,
-        # then recorded reals; integers (regimes) are read separately for recording only.
-        self.read_names: list[list[str]] = [[] for _ in self.names]
-        for c in scene.connections:
-            self._read_slot(*c.source)
-        self.record_slots: list[tuple[int, str, int]] = []  # (instance, kind, slot)
+        # Values read from each instance after every step, one getReal and one getInteger
+        # per instance: connection sources, recorded signals, and what masters watch.
+        self.real_names: list[list[str]] = [[] for _ in self.names]
         self.int_names: list[list[str]] = [[] for _ in self.names]
-        for inst, var in scene.record:
-            i = self.index[inst]
-            if self.instances[i].is_integer(var):
-                self.int_names[i].append(var)
-                self.record_slots.append((i, "int", len(self.int_names[i]) - 1))
-            else:
-                self.record_slots.append((i, "real", self._read_slot(inst, var)))
-        self.read_refs = [
-            inst.refs(names) for inst, names in zip(self.instances, self.read_names, strict=True)
-        ]
-        self.int_refs = [
-            inst.refs(names) for inst, names in zip(self.instances, self.int_names, strict=True)
-        ]
-        self.feeds: list[_Feed] = [_Feed([], []) for _ in self.names]
+        self.feeds = [_Feed([], [], [], []) for _ in self.names]
         for c in scene.connections:
             src, dst = self.index[c.source[0]], self.index[c.target[0]]
-            slot = self.read_names[src].index(c.source[1])
-            self.feeds[dst].sources.append((src, slot))
-            self.feeds[dst].refs.extend(self.instances[dst].refs([c.target[1]]))
+            kind, slot = self._slot(src, c.source[1])
+            target_ref = self.instances[dst].refs([c.target[1]])
+            if kind != ("int" if self.instances[dst].is_integer(c.target[1]) else "real"):
+                raise RunError(f"connection {c.source} -> {c.target} joins Real and Integer")
+            if kind == "int":
+                self.feeds[dst].int_sources.append((src, slot))
+                self.feeds[dst].int_refs.extend(target_ref)
+            else:
+                self.feeds[dst].real_sources.append((src, slot))
+                self.feeds[dst].real_refs.extend(target_ref)
+        self.record_slots = [
+            (self.index[inst],) + self._slot(self.index[inst], var) for inst, var in scene.record
+        ]
+        self.watches = [self._watch(i) for i in range(len(self.names))]
+        self.real_refs = [
+            inst.refs(n) for inst, n in zip(self.instances, self.real_names, strict=True)
+        ]
+        self.int_refs = [
+            inst.refs(n) for inst, n in zip(self.instances, self.int_names, strict=True)
+        ]
         self.values: list[list[float]] = [[] for _ in self.names]
-        self.int_values: list[list[int]] = [[] for _ in self.names]
+        self.ints: list[list[int]] = [[] for _ in self.names]
         self.record_header = [f"{inst}.{var}" for inst, var in scene.record]
 
-    def _read_slot(self, instance: str, var: str) -> int:
-        names = self.read_names[self.index[instance]]
+    def _slot(self, i: int, var: str) -> tuple[str, int]:
+        kind = "int" if self.instances[i].is_integer(var) else "real"
+        names = self.int_names[i] if kind == "int" else self.real_names[i]
         if var not in names:
             names.append(var)
-        return names.index(var)
+        return kind, names.index(var)
+
+    def _watch(self, i: int) -> Watch:
+        outputs = [
+            v.name
+            for v in self.instances[i].model_description.modelVariables
+            if v.causality == "output"
+        ]
+        indicators = [n for n in outputs if n.startswith("ind_")]
+        return Watch(
+            regime=self._slot(i, "regime")[1] if "regime" in outputs else None,
+            indicators=[self._slot(i, n)[1] for n in indicators],
+            indicator_names=indicators,
+            t_event=self._slot(i, "t_event")[1] if "t_event" in outputs else None,
+        )
 
     # -- life cycle -------------------------------------------------------------------
     def initialize(self) -> None:
@@ -93,7 +121,10 @@ class CoupledSystem:
     # -- transfers (hot path) ---------------------------------------------------------
     def read(self, i: int) -> None:
         inst = self.instances[i]
-        self.values[i] = inst.get_real(self.read_refs[i]) if self.read_refs[i] else []
+        if self.real_refs[i]:
+            self.values[i] = inst.get_real(self.real_refs[i])
+        if self.int_refs[i]:
+            self.ints[i] = inst.get_integer(self.int_refs[i])
 
     def read_all(self) -> None:
         for i in range(len(self.instances)):
@@ -102,21 +133,30 @@ class CoupledSystem:
     def feed(self, i: int) -> None:
         """Set instance i's inputs from the latest values read from its sources."""
         feed = self.feeds[i]
-        if feed.refs:
+        if feed.real_refs:
             values = self.values
-            self.instances[i].set_real(feed.refs, [values[s][k] for s, k in feed.sources])
+            self.instances[i].set_real(feed.real_refs, [values[s][k] for s, k in feed.real_sources])
+        if feed.int_refs:
+            ints = self.ints
+            self.instances[i].set_integer(feed.int_refs, [ints[s][k] for s, k in feed.int_sources])
 
     def step(self, i: int, t: float, h: float) -> None:
         self.instances[i].do_step(t, h)
 
     def record_row(self, t: float) -> list[float]:
-        for i, inst in enumerate(self.instances):
-            if self.int_refs[i]:
-                self.int_values[i] = inst.get_integer(self.int_refs[i])
         row = [t]
         for i, kind, slot in self.record_slots:
-            row.append(self.values[i][slot] if kind == "real" else self.int_values[i][slot])
+            row.append(self.values[i][slot] if kind == "real" else self.ints[i][slot])
         return row
+
+    def regimes(self) -> list[int | None]:
+        return [
+            self.ints[i][w.regime] if w.regime is not None else None
+            for i, w in enumerate(self.watches)
+        ]
+
+    def indicators(self) -> list[list[float]]:
+        return [[self.values[i][k] for k in w.indicators] for i, w in enumerate(self.watches)]
 
     # -- state ------------------------------------------------------------------------
     def get_state(self) -> list[Any]:

@@ -1,0 +1,253 @@
+"""The regime-aware master: steps that land on every regime switch, sized by an error test.
+
+Each macro step starts from a saved state of every FMU (fmi2GetFMUstate), so any trial can
+be rolled back.  A trial step is accepted when
+
+* no FMU changed regime, fired an internal event or crossed an event indicator (outputs
+  named ``ind_*``) inside it — otherwise the switching instant is located (from the FMU's
+  reported ``t_event`` when it has one, else by secant/bisection on the indicator) and the
+  step is retaken to land on it within ``event_tolerance``; and
+* the coupling error estimate is within ``tolerance``: the inputs are held over the step,
+  so the error made is proportional to how much the exchanged signals change over it,
+  measured relative to each signal's running scale.
+
+After a switch the master iterates the exchange at that instant to a fixed point (so an
+impact's momentum exchange reaches the other FMU before anything moves), records the left
+and right values, logs the switch, and restarts with a short step.  A guard stops runs
+that keep switching at one instant (chattering / Zeno) with a diagnosis.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+from orchestrator.errors import RunError
+from orchestrator.recorder import Recorder, StepStats
+from orchestrator.scenario import Scene, component_class
+from orchestrator.system import CoupledSystem
+
+
+@dataclass(frozen=True)
+class Settings:
+    tolerance: float
+    event_tolerance: float
+    first_step: float
+    min_step: float
+    max_step: float
+    max_iterations: int  # exchange rounds at a switching instant
+    max_events_per_step: int  # switches allowed at (nearly) one instant before giving up
+
+    @classmethod
+    def of(cls, scene: Scene) -> Settings:
+        o = scene.master.options
+        h = scene.master.step
+        return cls(
+            tolerance=o.get("tolerance", 1e-4),
+            event_tolerance=o.get("event_tolerance", 1e-10),
+            first_step=h,
+            min_step=o.get("min_step", 1e-14),
+            max_step=o.get("max_step", min(100.0 * h, scene.stop - scene.start)),
+            max_iterations=o.get("max_iterations", 10),
+            max_events_per_step=o.get("max_events_per_step", 50),
+        )
+
+
+@dataclass
+class _Snapshot:
+    """Everything read from the FMUs at one instant."""
+
+    values: list[list[float]]
+    ints: list[list[int]]
+    regimes: list[int | None]
+    indicators: list[list[float]]
+
+
+class RegimeAwareMaster:
+    def __init__(self, system: CoupledSystem, scene: Scene, recorder: Recorder, stats: StepStats):
+        self.system, self.scene, self.recorder, self.stats = system, scene, recorder, stats
+        self.cfg = Settings.of(scene)
+        self.names = system.names
+        self.regime_names = [
+            getattr(component_class(scene.fmus[n].fmu), "REGIME_NAMES", {}) for n in self.names
+        ]
+        # Exchanged Real signals: (instance, slot) of every connection source.
+        self.signals = sorted({src for feed in system.feeds for src in feed.real_sources})
+        self.scale = {s: 0.0 for s in self.signals}
+
+    # -- helpers ----------------------------------------------------------------------
+    def snapshot(self) -> _Snapshot:
+        s = self.system
+        return _Snapshot(
+            [list(v) for v in s.values], [list(v) for v in s.ints], s.regimes(), s.indicators()
+        )
+
+    def trial(self, t: float, h: float) -> None:
+        """One Jacobi pass over [t, t+h] with every input held at its value at t."""
+        system = self.system
+        for i in range(len(system.instances)):
+            system.feed(i)
+        for i in range(len(system.instances)):
+            system.step(i, t, h)
+        system.read_all()
+        self.stats.do_steps += len(system.instances)
+
+    def switch_time(self, t: float, h: float, before: _Snapshot) -> float | None:
+        """Earliest switching instant inside (t, t+h], or None if nothing switched.
+
+        An FMU that reports its internal event time gives it exactly; an indicator that
+        changed sign gives a linear (secant) estimate.
+        """
+        system = self.system
+        after_regimes, after_ind = system.regimes(), system.indicators()
+        best: float | None = None
+        for i, watch in enumerate(system.watches):
+            fired = after_regimes[i] != before.regimes[i]
+            if watch.t_event is not None:
+                te = system.values[i][watch.t_event]
+                if t < te <= t + h * (1 + 1e-12) and (fired or te > t):
+                    best = te if best is None else min(best, te)
+                    continue
+            for g0, g1 in zip(before.indicators[i], after_ind[i], strict=True):
+                if (g0 > 0.0) != (g1 > 0.0) and g0 != g1:
+                    te = t + h * g0 / (g0 - g1)
+                    best = te if best is None else min(best, te)
+            if fired and best is None:
+                best = t + 0.5 * h
+        return best
+
+    def error_ratio(self, before: _Snapshot) -> float:
+        """Held-input error estimate relative to the tolerance (<= 1 accepts)."""
+        values = self.system.values
+        worst = 0.0
+        tol = self.cfg.tolerance
+        for i, k in self.signals:
+            a, b = before.values[i][k], values[i][k]
+            scale = self.scale[(i, k)] = max(self.scale[(i, k)], abs(a), abs(b))
+            if scale > 0.0:
+                worst = max(worst, abs(b - a) / (tol * scale))
+        return worst
+
+    def settle(self) -> int:
+        """Exchange at one instant until the values stop changing (event iteration)."""
+        system = self.system
+        for rounds in range(1, self.cfg.max_iterations + 1):
+            old = [list(v) for v in system.values], [list(v) for v in system.ints]
+            for i in range(len(system.instances)):
+                system.feed(i)
+            system.read_all()
+            if (system.values, system.ints) == old:
+                return rounds
+        raise RunError(
+            f"the exchange at a switching instant did not settle"
+            f" in {self.cfg.max_iterations} rounds"
+        )
+
+    def log_switches(self, t: float, before: _Snapshot) -> int:
+        count = 0
+        for i, (r0, r1) in enumerate(zip(before.regimes, self.system.regimes(), strict=True)):
+            if r0 != r1:
+                names = self.regime_names[i]
+                self.recorder.event(
+                    t, self.names[i], names.get(r0, str(r0)), names.get(r1, str(r1))
+                )
+                count += 1
+        return count
+
+    # -- main loop --------------------------------------------------------------------
+    def run(self, progress) -> None:
+        cfg, system, stats, recorder = self.cfg, self.system, self.stats, self.recorder
+        t, stop = self.scene.start, self.scene.stop
+        h = cfg.first_step
+        target: float | None = None  # a switch seen in a rolled-back trial, not yet reached
+        recorder.row(system.record_row(t))
+        same_instant = 0
+        while t < stop - 1e-15 * max(1.0, abs(stop)):
+            if target is not None and target <= t:
+                target = None
+            h = min(h, stop - t)
+            if target is not None:
+                h = min(h, target - t + 0.5 * cfg.event_tolerance)
+            state = system.get_state()
+            before = self.snapshot()
+            try:
+                h, te = self._attempt(t, h, before, state)
+                if te is not None:
+                    left = self._left_values(t, te, h, state)
+            finally:
+                system.free_state(state)
+            t += h
+            stats.steps += 1
+            if te is None:
+                ratio = self.error_ratio(before)
+                recorder.row(system.record_row(t))
+                grow = 4.0 if ratio == 0.0 else min(4.0, max(0.2, 0.9 / ratio))
+                h = min(cfg.max_step, h * grow)
+                same_instant = 0
+            else:
+                target = None
+                if left is not None:
+                    recorder.row(left)  # values just before the switch
+                stats.iterations += self.settle() - 1
+                stats.events += max(self.log_switches(t, before), 1)
+                recorder.row(system.record_row(t))  # values just after the switch
+                same_instant = same_instant + 1 if h <= 10 * cfg.event_tolerance else 0
+                if same_instant > cfg.max_events_per_step:
+                    raise RunError(
+                        f"chattering: {same_instant} switches within "
+                        f"{10 * cfg.event_tolerance:.1e} s of each other; "
+                        f"last in {self._last_switch()}",
+                        t,
+                    )
+                h = cfg.first_step
+            progress(t)
+
+    def _attempt(self, t: float, h: float, before: _Snapshot, state: list[Any]):
+        """Trial steps from t until one is accepted; returns (h, switch time or None)."""
+        cfg = self.cfg
+        for _ in range(200):
+            self.trial(t, h)
+            te = self.switch_time(t, h, before)
+            if te is not None:
+                if t + h - te <= cfg.event_tolerance or h <= cfg.min_step:
+                    return h, te  # the step ends on the switch
+                # End the retaken step just past the located instant.
+                h = max(te - t + 0.5 * cfg.event_tolerance, cfg.min_step)
+                self._rollback(state)
+                continue
+            ratio = self.error_ratio(before)
+            if ratio > 1.0 and h > cfg.min_step:
+                h = max(cfg.min_step, h * max(0.2, 0.9 / ratio))
+                self._rollback(state)
+                continue
+            return h, None
+        raise RunError(f"no acceptable step from here after 200 trials (last h = {h:.3e} s)", t)
+
+    def _left_values(self, t: float, te: float, h: float, state: list[Any]) -> list[float] | None:
+        """Recorded values just before the switch at te (then the step is retaken to t+h)."""
+        h_left = te - t - 0.5 * self.cfg.event_tolerance
+        if h_left <= 0.0:
+            return None
+        self._rollback(state)
+        self.trial(t, h_left)
+        row = self.system.record_row(t + h_left)
+        self._rollback(state)
+        self.trial(t, h)
+        return row
+
+    def _rollback(self, state: list[Any]) -> None:
+        self.system.set_state(state)
+        self.stats.rollbacks += 1
+        self.stats.rejections += 1
+
+    def _last_switch(self) -> str:
+        if not self.recorder.events:
+            return "no FMU"
+        t, sub, a, b = self.recorder.events[-1]
+        return f"FMU {sub!r} ({a} -> {b})"
+
+
+def run_regime_aware(
+    system: CoupledSystem, scene: Scene, recorder: Recorder, stats: StepStats, progress
+) -> None:
+    RegimeAwareMaster(system, scene, recorder, stats).run(progress)

@@ -1,0 +1,222 @@
+"""Monolithic reference for the M739 S&A (Lowen & Tepper 1982): turns to arm and forces.
+
+The verge regime machine (``components.verge_escapement.VergeCore``) runs with the *live*
+train physics (``components.gear_train.TrainPhysics``) instead of a held affine response,
+so train and verge form one ODE system, integrated by the same RK4 stepper with exact
+location of every event (regime changes, impacts, mesh tooth changes and pitch points,
+friction reversals, arming angle).  No equation is repeated here.
+
+``run_m739`` returns turns to arm, arming time, force maxima (the report's F23MAX, F12MAX
+in coupled motion, FF23MAX, FF12MAX in free motion, PNMAX), number of impacts, a regime
+log [(t, from, to)] (codes of ``components.verge_escapement``: 0 free, 1 coupled on the
+entrance face, 2 coupled on the exit face), every event with its cause, and time series
+sampled every ``sample_dt`` (t, phi, phi_dot, psi, psi_dot, regime, f12, f23, pn; SI).
+It never raises: a run that cannot arm ends with ``armed = False`` and a reason (stall,
+self-locking, verge disengaged, stop time reached, numerical failure).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from components.gear_train import INDEXING_AS_RUN, INDEXING_PHYSICAL, TrainPhysics, advance
+from components.m739_data import M739, M739Data, rpm_to_rad_s
+from components.verge_escapement import REGIME_NAMES, VergeConstants, VergeCore
+
+
+@dataclass
+class M739Result:
+    """Outcome of one reference run (SI units)."""
+
+    armed: bool
+    reason: str
+    t_arm: float | None
+    turns: float | None
+    f23_max: float
+    f12_max: float
+    ff23_max: float
+    ff12_max: float
+    pn_max: float
+    impacts: int
+    regime_log: list[tuple[float, int, int]]
+    events: list[tuple[float, int, int, str]]
+    t_end: float
+    phi_end: float
+    series: dict[str, np.ndarray] = field(default_factory=dict)
+
+    def summary(self) -> str:
+        """One line, forces in lb (the report's unit)."""
+        from components.m739_data import LBF
+
+        head = f"armed in {self.turns:.3f} turns" if self.armed else f"did not arm: {self.reason}"
+        return (
+            f"{head}; F23 {self.f23_max / LBF:.3f} F12 {self.f12_max / LBF:.3f} "
+            f"FF23 {self.ff23_max / LBF:.3f} FF12 {self.ff12_max / LBF:.3f} "
+            f"PN {self.pn_max / LBF:.3f} lb; {self.impacts} impacts"
+        )
+
+
+class _Monolithic(VergeCore):
+    """VergeCore with live train physics, recording maxima and the time series."""
+
+    def __init__(self, *args: object, **kwargs: object) -> None:
+        super().__init__(*args, **kwargs)  # type: ignore[arg-type]
+        self.f23_max = self.f12_max = self.ff23_max = self.ff12_max = self.pn_max = 0.0
+
+    def record(self, y: list[float]) -> None:
+        """Forces at an accepted point (OUTP / OUTPF of the report)."""
+        tr = self.train
+        if self.coupled:
+            acc, _, _, _, pn, _, _, _, _, den, _ = self.coupled_terms(y)
+            j = tr.response(y[0], y[1])[0]
+            if den <= 0.0 or j <= 0.0:
+                self.fault = "self-locking: effective inertia not positive"
+                self.halted = True
+                return
+            f12, f23 = tr.forces(y[0], y[1], acc)
+            self.f23_max = max(self.f23_max, f23)
+            self.f12_max = max(self.f12_max, f12)
+            self.pn_max = max(self.pn_max, pn)
+        else:
+            acc = self.free_terms(y)[0]
+            f12, f23 = tr.forces(y[0], y[1], acc)
+            self.ff23_max = max(self.ff23_max, f23)
+            self.ff12_max = max(self.ff12_max, f12)
+
+    def accept(self, y: list[float], t: float) -> None:
+        super().accept(y, t)
+        self.record(y)
+
+    def event(self, y: list[float], index: int, t: float) -> list[float]:
+        y = super().event(y, index, t)
+        if self.train_stuck:
+            self.halted = True
+        elif not self.halted:
+            self.record(y)
+        return y
+
+
+def _indexing_code(indexing: int | str) -> int:
+    if isinstance(indexing, str):
+        key = indexing.strip().lower().replace("_", "-")
+        if key in ("physical", "phys"):
+            return INDEXING_PHYSICAL
+        if key in ("as-run", "asrun", "report"):
+            return INDEXING_AS_RUN
+        raise ValueError(f"unknown indexing {indexing!r}; use 'physical' or 'as-run'")
+    return int(indexing)
+
+
+def run_m739(
+    mu: float = M739.mu,
+    mu1: float = M739.mu1,
+    rpm: float = M739.rpm,
+    e_rest: float = M739.e_rest,
+    t_stop: float = 0.2,
+    indexing: int | str = "physical",
+    h_max: float = 2.0e-6,
+    sample_dt: float = 1.0e-5,
+    data: M739Data = M739,
+) -> M739Result:
+    """Simulate the M739 from rest on the entrance face until arming or t_stop.
+
+    Arming is phi_T = PHICUTD (1485 deg of escape wheel); turns = spin [rev/s] * t_arm.
+    """
+    omega = rpm_to_rad_s(rpm)
+    events: list[tuple[float, int, int, str]] = []
+
+    def log(t: float, old: int, new: int, why: str) -> None:
+        events.append((t, old, new, why))
+
+    code = _indexing_code(indexing)
+    train = TrainPhysics(data, mu=mu, omega=omega, indexing=code)
+    k = VergeConstants(data, mu1, mu, omega, e_rest)
+    core = _Monolithic(k, train, data.phi_start, phi_stop=data.phi_cut, log=log)
+    y = core._sync_kinematics([0.0, 0.0, 0.0, 0.0, 0.0])
+    if omega == 0.0:
+        return _finish(core, y, 0.0, False, "no spin: no driving torque", events, {})
+    core.s4 = core.s5 = 1  # V_S/T = 0 and psi_d = 0 at rest: +1 (§10.2 item 5)
+    core.record(y)  # the report's t = 0 printout uses these signs
+    y = core.decide_direction(y, 0.0, 1)  # then all friction signs follow the motion
+
+    names = ("t", "phi", "phi_dot", "psi", "psi_dot", "regime", "f12", "f23", "pn")
+    cols: dict[str, list[float]] = {n: [] for n in names}
+
+    def sample(t: float, y: list[float]) -> None:
+        cols["t"].append(t)
+        cols["phi"].append(y[0])
+        cols["phi_dot"].append(y[1])
+        body = y[2] + core.psic - data.psic
+        cols["psi"].append(math.atan2(math.sin(body), math.cos(body)))
+        cols["psi_dot"].append(y[3])
+        cols["regime"].append(core.regime)
+        if core.coupled:
+            acc, pn = core.coupled_terms(y)[0], core.coupled_terms(y)[4]
+        else:
+            acc, pn = core.free_terms(y)[0], 0.0
+        f12, f23 = core.train.forces(y[0], y[1], acc)
+        cols["f12"].append(f12)
+        cols["f23"].append(f23)
+        cols["pn"].append(pn)
+
+    t = 0.0
+    sample(t, y)
+    reason = "stop time reached"
+    try:
+        while t < t_stop and not core.train_stuck:
+            h = min(sample_dt, t_stop - t)
+            core.t_base = t
+            y, t_ev, _ = advance(core, y, h, h_max)
+            if core.halted:
+                t += t_ev if t_ev >= 0.0 else h
+                sample(t, y)
+                break
+            t += h
+            sample(t, y)
+    except (ArithmeticError, ValueError, RuntimeError) as exc:
+        return _finish(core, y, t, False, f"numerical failure: {exc}", events, cols)
+    if core.halted and not core.train_stuck and not core.fault:
+        return _finish(core, y, t, True, "armed", events, cols)
+    if core.train_stuck:
+        reason = f"stall: {core.stall_reason}"
+    elif core.fault:
+        reason = core.fault
+    return _finish(core, y, t, False, reason, events, cols)
+
+
+def _finish(
+    core: _Monolithic,
+    y: list[float],
+    t: float,
+    armed: bool,
+    reason: str,
+    events: list[tuple[float, int, int, str]],
+    cols: dict[str, list[float]],
+) -> M739Result:
+    regime_log = [(te, a, b) for te, a, b, _ in events if a != b]
+    spin = abs(core.k.omega) / (2.0 * math.pi)
+    return M739Result(
+        armed=armed,
+        reason=reason,
+        t_arm=t if armed else None,
+        turns=spin * t if armed else None,
+        f23_max=core.f23_max,
+        f12_max=core.f12_max,
+        ff23_max=core.ff23_max,
+        ff12_max=core.ff12_max,
+        pn_max=core.pn_max,
+        impacts=core.impacts,
+        regime_log=regime_log,
+        events=events,
+        t_end=t,
+        phi_end=y[0],
+        series={n: np.asarray(v) for n, v in cols.items()},
+    )
+
+
+def regime_name(code: int) -> str:
+    """Readable name of a VergeEscapement regime code."""
+    return REGIME_NAMES.get(code, str(code))
