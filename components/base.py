@@ -40,6 +40,10 @@ class Variable:
     start: float
     description: str = ""
     type: Literal["Real", "Integer"] = "Real"
+    #: An input that is an initial state taken at the start of each step (e.g. the angle of
+    #: a shaft the component follows), not a signal held over the step.  Masters judge the
+    #: error of holding inputs on held signals only.
+    sampled: bool = False
 
 
 class ComponentError(RuntimeError):

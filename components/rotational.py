@@ -62,7 +62,7 @@ class SpringDamperInertia(Component):
         Variable("max_twist", "parameter", "rad", 1.0e30, "twist at which the coupling breaks"),
         Variable("phi0", "parameter", "rad", 0.0, "initial angle"),
         Variable("w0", "parameter", "rad/s", 0.0, "initial angular velocity"),
-        Variable("phi_in", "input", "rad", 0.0, "angle of the other body's port"),
+        Variable("phi_in", "input", "rad", 0.0, "angle of the other body's port", sampled=True),
         Variable("w_in", "input", "rad/s", 0.0, "angular velocity of the other body's port"),
         Variable("phi", "output", "rad", 0.0, "angle"),
         Variable("w", "output", "rad/s", 0.0, "angular velocity"),

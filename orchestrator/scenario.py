@@ -65,6 +65,15 @@ class HeadlineSpec:
 
 
 @dataclass(frozen=True)
+class StopCondition:
+    """End the run when a signal first reaches a threshold (e.g. an S&A arming angle)."""
+
+    signal: tuple[str, str]
+    threshold: float  # in the signal's SI unit
+    rising: bool  # True: stop when the signal rises to the threshold; False: falls to it
+
+
+@dataclass(frozen=True)
 class Scene:
     path: Path
     name: str
@@ -81,6 +90,7 @@ class Scene:
     analysis: str | None
     analysis_options: dict[str, Any]
     reference: str | None = None
+    stop_when: StopCondition | None = None
 
     def component_class(self, instance: str) -> type[Component]:
         return component_class(self.fmus[instance].fmu)
@@ -159,7 +169,7 @@ class _Loader:
             if section not in raw:
                 raise self.fail(section, "missing section")
         head = self.table(raw["scene"], "scene")
-        self.check_keys(head, "scene", {"name", "description", "start", "stop"})
+        self.check_keys(head, "scene", {"name", "description", "start", "stop", "stop_when"})
         name = self.string(head, "name", "scene.name")
         start = self.quantity(head.get("start", 0.0), "scene.start", "s")
         if "stop" not in head:
@@ -168,6 +178,7 @@ class _Loader:
         if not stop > start:
             raise self.fail("scene.stop", f"must be later than scene.start ({start} s), got {stop}")
         fmus = self.fmus(self.table(raw["fmus"], "fmus"))
+        stop_when = self.stop_when(head["stop_when"], fmus) if "stop_when" in head else None
         connections = self.connections(raw.get("connections", []), fmus)
         master = self.master(self.table(raw["master"], "master"), fmus, stop - start)
         record, every, out_dir = self.output(
@@ -191,7 +202,24 @@ class _Loader:
             analysis=analysis,
             analysis_options=options,
             reference=reference,
+            stop_when=stop_when,
         )
+
+    def stop_when(self, node: Any, fmus: dict[str, FmuSpec]) -> StopCondition:
+        key = "scene.stop_when"
+        node = self.table(node, key)
+        self.check_keys(node, key, {"signal", "above", "below"})
+        if "signal" not in node:
+            raise self.fail(f"{key}.signal", "missing; expected '<instance>.<variable>'")
+        signal = self.signal(node["signal"], f"{key}.signal", fmus, "output")
+        if ("above" in node) == ("below" in node):
+            raise self.fail(key, "expected exactly one of 'above' or 'below' (the threshold)")
+        side = "above" if "above" in node else "below"
+        var = component_class(fmus[signal[0]].fmu).variable(signal[1])
+        if var.type != "Real":
+            raise self.fail(f"{key}.signal", f"{signal[1]!r} is not a Real output")
+        threshold = self.quantity(node[side], f"{key}.{side}", var.unit)
+        return StopCondition(signal, threshold, rising=side == "above")
 
     def fmus(self, node: dict[str, Any]) -> dict[str, FmuSpec]:
         if not node:

@@ -54,9 +54,12 @@ class CoupledSystem:
         self.real_names: list[list[str]] = [[] for _ in self.names]
         self.int_names: list[list[str]] = [[] for _ in self.names]
         self.feeds = [_Feed([], [], [], []) for _ in self.names]
+        #: per connection, (source instance, slot) of a Real source, None for an Integer one
+        self.connection_sources: list[tuple[int, int] | None] = []
         for c in scene.connections:
             src, dst = self.index[c.source[0]], self.index[c.target[0]]
             kind, slot = self._slot(src, c.source[1])
+            self.connection_sources.append((src, slot) if kind == "real" else None)
             target_ref = self.instances[dst].refs([c.target[1]])
             if kind != ("int" if self.instances[dst].is_integer(c.target[1]) else "real"):
                 raise RunError(f"connection {c.source} -> {c.target} joins Real and Integer")
@@ -70,6 +73,10 @@ class CoupledSystem:
             (self.index[inst],) + self._slot(self.index[inst], var) for inst, var in scene.record
         ]
         self.watches = [self._watch(i) for i in range(len(self.names))]
+        self.stop_slot: tuple[int, int] | None = None
+        if scene.stop_when is not None:
+            inst, var = scene.stop_when.signal
+            self.stop_slot = (self.index[inst], self._slot(self.index[inst], var)[1])
         self.real_refs = [
             inst.refs(n) for inst, n in zip(self.instances, self.real_names, strict=True)
         ]
@@ -148,6 +155,14 @@ class CoupledSystem:
         for i, kind, slot in self.record_slots:
             row.append(self.values[i][slot] if kind == "real" else self.ints[i][slot])
         return row
+
+    def stop_indicator(self) -> float | None:
+        """Signed distance to the scene's stop condition: reaches 0 when it is met."""
+        if self.stop_slot is None:
+            return None
+        cond = self.scene.stop_when
+        value = self.values[self.stop_slot[0]][self.stop_slot[1]]
+        return cond.threshold - value if cond.rising else value - cond.threshold
 
     def regimes(self) -> list[int | None]:
         return [

@@ -50,9 +50,14 @@ def _run(
         t = scene.start + (k + 1) * h if k < n - 1 else scene.stop
         stats.steps += 1
         stats.do_steps += m
-        if (k + 1) % every == 0 or k == n - 1:
+        stop = system.stop_indicator()
+        done = stop is not None and stop <= 0.0
+        if (k + 1) % every == 0 or k == n - 1 or done:
             recorder.row(system.record_row(t))
         progress(t)
+        if done:  # a fixed-step master stops at the first step past the condition
+            stats.extra["stopped_by_condition"] = True
+            return
 
 
 def run_jacobi(

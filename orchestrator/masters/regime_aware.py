@@ -61,6 +61,7 @@ class _Snapshot:
     ints: list[list[int]]
     regimes: list[int | None]
     indicators: list[list[float]]
+    stop: float | None  # the scene's stop indicator (> 0 until the condition is met)
 
 
 class RegimeAwareMaster:
@@ -79,7 +80,11 @@ class RegimeAwareMaster:
     def snapshot(self) -> _Snapshot:
         s = self.system
         return _Snapshot(
-            [list(v) for v in s.values], [list(v) for v in s.ints], s.regimes(), s.indicators()
+            [list(v) for v in s.values],
+            [list(v) for v in s.ints],
+            s.regimes(),
+            s.indicators(),
+            s.stop_indicator(),
         )
 
     def trial(self, t: float, h: float) -> None:
@@ -96,11 +101,14 @@ class RegimeAwareMaster:
         """Earliest switching instant inside (t, t+h], or None if nothing switched.
 
         An FMU that reports its internal event time gives it exactly; an indicator that
-        changed sign gives a linear (secant) estimate.
+        changed sign (the scene's stop condition among them) gives a secant estimate.
         """
         system = self.system
         after_regimes, after_ind = system.regimes(), system.indicators()
         best: float | None = None
+        g1 = system.stop_indicator()
+        if g1 is not None and g1 <= 0.0 < before.stop:
+            best = t + h * before.stop / (before.stop - g1)
         for i, watch in enumerate(system.watches):
             fired = after_regimes[i] != before.regimes[i]
             if watch.t_event is not None:
@@ -201,6 +209,10 @@ class RegimeAwareMaster:
                     )
                 h = cfg.first_step
             progress(t)
+            stop_indicator = system.stop_indicator()
+            if stop_indicator is not None and stop_indicator <= 0.0:
+                stats.extra["stopped_by_condition"] = True
+                return
 
     def _attempt(self, t: float, h: float, before: _Snapshot, state: list[Any]):
         """Trial steps from t until one is accepted; returns (h, switch time or None)."""

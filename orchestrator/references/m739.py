@@ -169,7 +169,7 @@ def run_m739(
         while t < t_stop and not core.train_stuck:
             h = min(sample_dt, t_stop - t)
             core.t_base = t
-            y, t_ev, _ = advance(core, y, h, h_max)
+            y, _, t_ev, _ = advance(core, y, h, h_max)
             if core.halted:
                 t += t_ev if t_ev >= 0.0 else h
                 sample(t, y)
