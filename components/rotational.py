@@ -9,8 +9,6 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
-
 from components.base import COMMON_OUTPUTS, Component, ComponentError, Variable
 
 
@@ -77,7 +75,7 @@ class SpringDamperInertia(Component):
                 f"SpringDamperInertia: need J > 0, k >= 0, d >= 0; got {self.J}, {self.k}, {self.d}"
             )
         self.phi, self.w = self.phi0, self.w0
-        self._transition: dict[float, np.ndarray] = {}
+        self._cache_transition: dict[float, tuple[float, float, float, float]] = {}
         self.update_outputs()
 
     def update_outputs(self) -> None:
@@ -90,14 +88,14 @@ class SpringDamperInertia(Component):
         # port moves at constant speed, so the step is the exact 2x2 transition matrix.
         y0 = self.phi - self.phi_in
         v0 = self.w - self.w_in
-        m = self._transition.get(h)
+        m = self._cache_transition.get(h)
         if m is None:
             m = damped_oscillator_transition(self.k / self.J, self.d / self.J, h)
-            if len(self._transition) > 8:  # variable steps: keep the state small
-                self._transition.clear()
-            self._transition[h] = m
-        y1 = m[0, 0] * y0 + m[0, 1] * v0
-        v1 = m[1, 0] * y0 + m[1, 1] * v0
+            if len(self._cache_transition) > 8:  # variable steps: keep the state small
+                self._cache_transition.clear()
+            self._cache_transition[h] = m
+        y1 = m[0] * y0 + m[1] * v0
+        v1 = m[2] * y0 + m[3] * v0
         # Work dissipated by the damper over the step: integral of d*y'^2, exact for the
         # same transition (trapezoid would be O(h^2)); use energy of the relative motion.
         e0 = 0.5 * self.J * v0**2 + 0.5 * self.k * y0**2
@@ -113,8 +111,13 @@ class SpringDamperInertia(Component):
         self.update_outputs()
 
 
-def damped_oscillator_transition(k_over_j: float, d_over_j: float, h: float) -> np.ndarray:
-    """exp(A h) for A = [[0, 1], [-k/J, -d/J]], in closed form for every damping case."""
+def damped_oscillator_transition(
+    k_over_j: float, d_over_j: float, h: float
+) -> tuple[float, float, float, float]:
+    """exp(A h) for A = [[0, 1], [-k/J, -d/J]], row by row, in closed form for every damping.
+
+    Plain floats (not numpy scalars): they end up in the state, which is saved every step.
+    """
     a = 0.5 * d_over_j
     disc = a * a - k_over_j
     e = math.exp(-a * h)
@@ -126,4 +129,4 @@ def damped_oscillator_transition(k_over_j: float, d_over_j: float, h: float) -> 
         c, s = math.cosh(r * h), math.sinh(r * h) / r
     else:  # critically damped
         c, s = 1.0, h
-    return e * np.array([[c + a * s, s], [-k_over_j * s, c - a * s]])
+    return (e * (c + a * s), e * s, -e * k_over_j * s, e * (c - a * s))

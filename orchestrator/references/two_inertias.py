@@ -34,8 +34,8 @@ def two_inertias_exact(
     v = np.empty_like(t)
     for n, tn in enumerate(t):
         m = damped_oscillator_transition(k / j_red, d / j_red, float(tn))
-        x[n] = m[0, 0] * x0 + m[0, 1] * v0
-        v[n] = m[1, 0] * x0 + m[1, 1] * v0
+        x[n] = m[0] * x0 + m[1] * v0
+        v[n] = m[2] * x0 + m[3] * v0
     centre = centre0 + centre_w * t
     return {
         "phi_a": centre + J_b / total * x,
