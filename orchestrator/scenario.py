@@ -8,6 +8,7 @@ names the file, the key and what was expected.  The schema is documented in
 from __future__ import annotations
 
 import importlib
+import math
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -91,6 +92,7 @@ class Scene:
     analysis_options: dict[str, Any]
     reference: str | None = None
     stop_when: StopCondition | None = None
+    error_bound: float = math.inf  # the error against the reference the scene claims
 
     def component_class(self, instance: str) -> type[Component]:
         return component_class(self.fmus[instance].fmu)
@@ -185,7 +187,7 @@ class _Loader:
             self.table(raw.get("output", {}), "output"), fmus, name
         )
         report = self.table(raw.get("report", {}), "report")
-        headline, analysis, options, reference = self.report(report, fmus)
+        headline, analysis, options, reference, error_bound = self.report(report, fmus)
         return Scene(
             path=self.path,
             name=name,
@@ -203,6 +205,7 @@ class _Loader:
             analysis_options=options,
             reference=reference,
             stop_when=stop_when,
+            error_bound=error_bound,
         )
 
     def stop_when(self, node: Any, fmus: dict[str, FmuSpec]) -> StopCondition:
@@ -383,7 +386,9 @@ class _Loader:
         return record, every, Path(directory)
 
     def report(self, node: dict[str, Any], fmus: dict[str, FmuSpec]):
-        self.check_keys(node, "report", {"headline", "analysis", "options", "reference"})
+        self.check_keys(
+            node, "report", {"headline", "analysis", "options", "reference", "error_bound"}
+        )
         headline: dict[str, HeadlineSpec] = {}
         for hname, entry in self.table(node.get("headline", {}), "report.headline").items():
             key = f"report.headline.{hname}"
@@ -417,4 +422,7 @@ class _Loader:
                 raise self.fail(
                     "report.reference", f"unknown {reference!r}; expected one of {known}"
                 )
-        return headline, analysis, dict(options), reference
+        bound = node.get("error_bound", math.inf)
+        if isinstance(bound, bool) or not isinstance(bound, int | float) or not bound > 0:
+            raise self.fail("report.error_bound", f"expected a positive number, got {bound!r}")
+        return headline, analysis, dict(options), reference, float(bound)
