@@ -1,0 +1,684 @@
+"""M739 gear train: eccentric rotor, gear/pinion set 2, escape wheel/pinion 3 (1 DOF).
+
+Physics of Lowen & Tepper (1982), note ``models/sa_verge_escapement.md`` §1.2, §2.4, §4.
+The generalized coordinate is the cumulative escape-wheel angle phi (= phi_T, radians,
+0 at the start).  The rotor turns by n31*phi, gear 2 by n32*phi.
+
+Train equation with the escapement load as an input torque.  Eliminating F12 and F23
+from the rotor (B144), gear-2 (B171) and escape-wheel (B96) moment equations gives
+
+    J_ref * phi_dd = T_ref + c_load * T_esc                                    (*)
+
+    J_ref = I3 - A15 (I2 N32 - A42 I1R N31 / A31) / A44          (= A55, B193)
+    T_ref = -A56 phi_d^2 - A57 phi_d + A58 - A59 sin(Phi)         (B193 right side)
+    c_load = 1
+
+where ``T_esc`` is the effective moment of the escapement on the escape-wheel shaft,
+including the escape-wheel pivot friction caused by the tooth force: T_esc = -A17 Pn
+(entrance; -AA17 Pn on the exit face).  The conservative |Fx|+|Fy| pivot model is a sum
+of one term per load, so that share is exactly separable; it depends on the direction of
+the tooth force (verge state), so the escapement side computes it.  With that split the
+dependence on T_esc is exactly affine with unit factor.  It is only piecewise in the
+*state*: the pieces are selected by sgn(phi_d) (friction reversal, eq. 7), by the
+approach/recess signs s1, s2 of both meshes and the current tooth pair, and by the
+branch of I1R (sign of phi_d times the previous accepted acceleration).  The outputs
+J_ref, T_ref are those of the piece in force at the current state.
+
+Mesh position (§2.4, §10.2 item 6): alpha_i = alpha_in + mod(k_i phi + J_i range, range)
+with k2 = r_b3/R_b2 (physical, default) or 32 r_b3/R_b2 (the report's as-run rate),
+k1 = k2 r_b2/R_b1.  Tooth changes and pitch-point crossings are located as events.
+
+The module also holds the fixed-step RK4 integrator with event location used by both
+M739 components and the monolithic reference.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from typing import Any, Protocol
+
+from components.base import COMMON_OUTPUTS, Component, ComponentError, Variable
+from components.m739_data import M739, M739Data
+from components.verge_geometry import fuze_angles
+
+INDEXING_PHYSICAL = 0
+INDEXING_AS_RUN = 1
+
+# Train regime codes.
+TRAIN_STUCK = 0
+TRAIN_FORWARD = 1
+TRAIN_BACKWARD = 2
+TRAIN_REGIME_NAMES = {TRAIN_STUCK: "stuck", TRAIN_FORWARD: "forward", TRAIN_BACKWARD: "backward"}
+
+
+# ---------------------------------------------------------------------------------------
+# Integrator: RK4 with event location on signed indicators
+# ---------------------------------------------------------------------------------------
+class EventModel(Protocol):
+    """What :func:`advance` needs from a model (the mode lives inside the model)."""
+
+    def deriv(self, y: list[float]) -> list[float]: ...
+
+    def indicators(self, y: list[float]) -> Sequence[float]: ...
+
+    def event(self, y: list[float], index: int, t: float) -> list[float]: ...
+
+    def accept(self, y: list[float], t: float) -> None: ...
+
+
+def rk4(deriv: Callable[[list[float]], list[float]], y: list[float], h: float) -> list[float]:
+    """One classical Runge-Kutta step (the mode is frozen during the step)."""
+    n = len(y)
+    k1 = deriv(y)
+    k2 = deriv([y[i] + 0.5 * h * k1[i] for i in range(n)])
+    k3 = deriv([y[i] + 0.5 * h * k2[i] for i in range(n)])
+    k4 = deriv([y[i] + h * k3[i] for i in range(n)])
+    h6 = h / 6.0
+    return [y[i] + h6 * (k1[i] + 2.0 * (k2[i] + k3[i]) + k4[i]) for i in range(n)]
+
+
+def _locate(
+    model: EventModel, y: list[float], h: float, idx: int, g_lo: float, g_hi: float, tol: float
+) -> tuple[float, list[float]]:
+    """Illinois root search on the step length for indicator idx (g_lo >= 0 > g_hi).
+
+    Returns the first point found with the indicator < 0, i.e. just past the crossing,
+    so that the event handler always sees the new side.
+    """
+    lo, hi = 0.0, h
+    y_hi = None
+    side = 0
+    for _ in range(60):
+        if hi - lo <= tol:
+            break
+        th = hi - g_hi * (hi - lo) / (g_hi - g_lo)
+        if not (lo < th < hi):
+            th = 0.5 * (lo + hi)
+        yt = rk4(model.deriv, y, th)
+        gt = model.indicators(yt)[idx]
+        if gt < 0.0:
+            hi, g_hi, y_hi = th, gt, yt
+            if side == -1:
+                g_lo *= 0.5
+            side = -1
+        else:
+            lo, g_lo = th, gt
+            if side == 1:
+                g_hi *= 0.5
+            side = 1
+    if y_hi is None:
+        y_hi = rk4(model.deriv, y, hi)
+    return hi, y_hi
+
+
+def advance(
+    model: EventModel,
+    y: list[float],
+    h_total: float,
+    h_max: float,
+    tol_t: float = 1e-14,
+    max_events: int = 2000,
+) -> tuple[list[float], float, float, int]:
+    """Integrate over h_total in RK4 steps <= h_max, stopping exactly at indicator crossings.
+
+    An indicator fires when it goes from >= 0 to < 0.  The model's ``event`` changes its
+    mode (and may change y); the integration then continues from the event point.
+    Returns (y, offsets of the first and of the last event from the start (-1.0 if
+    none), number of events).
+    """
+    t = 0.0
+    g0 = model.indicators(y)
+    n_events = 0
+    t_first = t_event = -1.0
+    end = h_total * (1.0 - 1e-14)
+    while t < end:
+        h = min(h_max, h_total - t)
+        y1 = rk4(model.deriv, y, h)
+        g1 = model.indicators(y1)
+        first = -1
+        th_best = h
+        y_best = y1
+        for i, (a, b) in enumerate(zip(g0, g1, strict=True)):
+            if a >= 0.0 and b < 0.0:
+                if a == 0.0:
+                    th, yy = 0.0, y
+                else:
+                    th, yy = _locate(model, y, h, i, a, b, tol_t)
+                if first < 0 or th < th_best:
+                    first, th_best, y_best = i, th, yy
+        if first < 0:
+            y = y1
+            t += h
+            model.accept(y, t)
+            g0 = g1
+            continue
+        y = y_best
+        t += th_best
+        if th_best > 0.0:
+            model.accept(y, t)
+        y = model.event(y, first, t)
+        g0 = model.indicators(y)
+        t_event = t
+        if t_first < 0.0:
+            t_first = t
+        n_events += 1
+        if n_events > max_events:
+            raise ComponentError("too many events inside one step (chattering)")
+        if getattr(model, "halted", False):
+            break
+    return y, t_first, t_event, n_events
+
+
+# ---------------------------------------------------------------------------------------
+# Train physics (IN2 coefficients, B144, B171, B193)
+# ---------------------------------------------------------------------------------------
+def mesh_limits(
+    rb_drv: float, rb_dvn: float, theta: float, ro_drv: float, ro_dvn: float
+) -> tuple[float, float]:
+    """Driver roll angle at start and end of contact (subroutine ALFA)."""
+    al_in = ((rb_drv + rb_dvn) * math.tan(theta) - math.sqrt(ro_dvn**2 - rb_dvn**2)) / rb_drv
+    al_fin = math.sqrt(ro_drv**2 - rb_drv**2) / rb_drv
+    return al_in, al_fin
+
+
+class TrainPhysics:
+    """Coefficients and affine response of the train, with its discrete mode.
+
+    Mode: direction (sign of mu, eq. 7), tooth pair index n_i and approach/recess sign
+    s_i of each mesh, and the I1R branch.  All are frozen inside an integrator stage.
+    """
+
+    def __init__(
+        self,
+        data: M739Data = M739,
+        mu: float | None = None,
+        omega: float | None = None,
+        indexing: int = INDEXING_PHYSICAL,
+    ) -> None:
+        d = data
+        self.d = d
+        self.mu_abs = abs(d.mu if mu is None else mu)
+        self.omega = d.omega if omega is None else omega
+        ang = fuze_angles(d)
+        self.angles = ang
+        om2 = self.omega**2
+        self.om2 = om2
+        self.om_abs = abs(self.omega)
+        self.n31 = d.n31
+        self.n32 = d.n32
+        self.t2 = d.m2 * d.r2 * om2  # centrifugal pivot loads
+        self.t3 = d.m3 * d.r3 * om2
+        self.a35 = d.m1 * d.r1 * d.rc1 * om2
+        self.tan1 = math.tan(d.theta1)
+        self.tan2 = math.tan(d.theta2)
+        self.d1 = (d.rb1_cap + d.rb2) * self.tan1
+        self.d2 = (d.rb2_cap + d.rb3) * self.tan2
+        self.al1_in, self.al1_fin = mesh_limits(d.rb1_cap, d.rb2, d.theta1, d.ro1_cap, d.ro2)
+        self.al2_in, self.al2_fin = mesh_limits(d.rb2_cap, d.rb3, d.theta2, d.ro2_cap, d.ro3)
+        self.range1 = self.al1_fin - self.al1_in
+        self.range2 = self.al2_fin - self.al2_in
+        k2 = d.rb3 / d.rb2_cap
+        if int(indexing) == INDEXING_AS_RUN:
+            k2 *= 32.0
+        self.k2 = k2
+        self.k1 = k2 * d.rb2 / d.rb1_cap
+        # Mesh phases in units of one contact interval: u = k phi / range + J.
+        self.du1 = self.k1 / self.range1
+        self.du2 = self.k2 / self.range2
+        self.p1 = (self.tan1 - self.al1_in) / self.range1  # pitch point, fraction of range
+        self.p2 = (self.tan2 - self.al2_in) / self.range2
+        self.i_stot = d.i_stot
+        self._cache: dict[tuple[int, int, int], tuple[float, ...]] = {}
+        # Mode.
+        self.direction = 1
+        self.i1r_sign = 1
+        self.n1 = self.n2 = 0
+        self.s1 = self.s2 = 1
+        self.phi_lo = -math.inf
+        self.phi_hi = math.inf
+        self._k: tuple[float, ...] = ()
+        self.set_mode(0.0, 1)
+
+    # -- mode ---------------------------------------------------------------------------
+    def _piece(self, u: float, p: float, direction: int) -> tuple[int, int, float, float]:
+        """Tooth index, sign and the u-interval of the smooth piece containing u."""
+        n = math.floor(u)
+        fr = u - n
+        if direction < 0 and fr == 0.0:
+            n -= 1
+            fr = 1.0
+        if fr < p or (fr == p and direction < 0):
+            return n, 1, n, n + p  # approach: s = +1
+        return n, -1, n + p, n + 1.0  # recess: s = -1
+
+    def set_mode(self, phi: float, direction: int) -> None:
+        """Set the mesh pieces from the position phi and the direction of motion."""
+        d = self.d
+        self.direction = 1 if direction >= 0 else -1
+        u1 = self.du1 * phi + d.j1
+        u2 = self.du2 * phi + d.j2
+        self.n1, self.s1, lo1, hi1 = self._piece(u1, self.p1, self.direction)
+        self.n2, self.s2, lo2, hi2 = self._piece(u2, self.p2, self.direction)
+        self.phi_lo = max((lo1 - d.j1) / self.du1, (lo2 - d.j2) / self.du2)
+        self.phi_hi = min((hi1 - d.j1) / self.du1, (hi2 - d.j2) / self.du2)
+        self._k = self._constants(self.direction, self.s1, self.s2)
+
+    def _constants(self, direction: int, s1: int, s2: int) -> tuple[float, ...]:
+        """Coefficients that depend only on the mode (IN2: A10-A14, A16, A23, A27, A36-A43)."""
+        key = (direction, s1, s2)
+        hit = self._cache.get(key)
+        if hit is not None:
+            return hit
+        d, ang = self.d, self.angles
+        mu = self.mu_abs * direction
+        dn = 1.0 + mu * mu
+        sb2, cb2 = math.sin(ang.beta2 + d.theta2), math.cos(ang.beta2 + d.theta2)
+        sb1, cb1 = math.sin(ang.beta1 - d.theta1), math.cos(ang.beta1 - d.theta1)
+        sg3, cg3 = math.sin(ang.gamma3), math.cos(ang.gamma3)
+        sg2, cg2 = math.sin(ang.gamma2), math.cos(ang.gamma2)
+        a10 = abs(-mu * (1 - s2) * sb2 - (1 + mu * mu * s2) * cb2) / dn
+        a13 = abs(-(1 + mu * mu * s2) * sb2 + mu * (1 - s2) * cb2) / dn
+        a11 = abs(sg3 - mu * cg3) / dn
+        a14 = abs(cg3 + mu * sg3) / dn
+        a16 = mu * d.rho3 * (a11 + a14)
+        a23 = abs((1 - mu * mu * s1) * sb1 - mu * (1 + s1) * cb1) / dn
+        a27 = abs(mu * (1 + s1) * sb1 + (1 - mu * mu * s1) * cb1) / dn
+        a36 = abs((1 - mu * mu * s2) * sb2 + mu * (1 + s2) * cb2) / dn
+        a39 = abs(mu * (1 + s2) * sb2 - (1 - mu * mu * s2) * cb2) / dn
+        a37 = abs((1 + mu * mu * s1) * sb1 + mu * (1 - s1) * cb1) / dn
+        a40 = abs(mu * (1 - s1) * sb1 - (1 + mu * mu * s1) * cb1) / dn
+        a38 = abs(cg2 - mu * sg2) / dn
+        a41 = abs(mu * cg2 + sg2) / dn
+        a43 = mu * d.rho2 * (a38 + a41)
+        out = (
+            mu,
+            dn,
+            # A15 = rb3 - mu s2 (d2 - a2) - mu rho3 (A10 + A13)
+            d.rb3 - mu * d.rho3 * (a10 + a13),
+            a16,
+            # A31 = Rb1 - mu s1 a1 + mu rho1 (A23 + A27)
+            d.rb1_cap + mu * d.rho1 * (a23 + a27),
+            # A42 = rb2 - mu s1 (d1 - a1) - mu rho2 (A37 + A40)
+            d.rb2 - mu * d.rho2 * (a37 + a40),
+            a43,
+            # A44 = Rb2 - mu s2 a2 + mu rho2 (A36 + A39)
+            d.rb2_cap + mu * d.rho2 * (a36 + a39),
+            a10,
+            a13,
+            a23,
+            a27,
+        )
+        self._cache[key] = out
+        return out
+
+    def mode_key(self) -> tuple[int, ...]:
+        """Everything discrete the response depends on (for memoisation by callers)."""
+        return (self.direction, self.i1r_sign, self.n1, self.n2, self.s1, self.s2)
+
+    def mesh_alphas(self, phi: float) -> tuple[float, float]:
+        """Driver roll angles of both meshes on the current tooth pairs."""
+        d = self.d
+        al1 = self.al1_in + self.range1 * (self.du1 * phi + d.j1 - self.n1)
+        al2 = self.al2_in + self.range2 * (self.du2 * phi + d.j2 - self.n2)
+        return al1, al2
+
+    # -- coefficients -------------------------------------------------------------------
+    def coefficients(self, phi: float) -> dict[str, float]:
+        """The A-coefficients of IN2 that belong to the train, at phi (for checks)."""
+        d = self.d
+        mu, dn, a15c, a16, a31c, a42c, a43, a44c, a10, a13, a23, a27 = self._k
+        al1, al2 = self.mesh_alphas(phi)
+        a1 = al1 * d.rb1_cap
+        a2 = al2 * d.rb2_cap
+        big_phi = d.phi1c + self.n31 * phi
+        sp, cp = math.sin(big_phi), math.cos(big_phi)
+        m1r = d.m1 * d.rc1
+        a24 = abs(d.m1 * (d.r1 + d.rc1 * (cp + mu * sp))) / dn
+        a28 = abs(mu * d.m1 * d.r1 + m1r * (mu * cp - sp)) / dn
+        a25 = abs(m1r * (cp + mu * sp)) / dn
+        a29 = abs(m1r * (mu * cp - sp)) / dn
+        a26 = abs(m1r * (sp - mu * cp)) / dn
+        a30 = abs(m1r * (mu * sp + cp)) / dn
+        return {
+            "mu": mu,
+            "A10": a10,
+            "A13": a13,
+            "A15": a15c - mu * self.s2 * (self.d2 - a2),
+            "A16": a16,
+            "A23": a23,
+            "A27": a27,
+            "A24": a24,
+            "A25": a25,
+            "A26": a26,
+            "A28": a28,
+            "A29": a29,
+            "A30": a30,
+            "A31": a31c - mu * self.s1 * a1,
+            "A32": mu * d.rho1 * self.om2 * (a24 + a28),
+            "A33": 2.0 * abs(mu) * d.rho1 * self.om_abs * (a25 + a29),
+            "A34": mu * d.rho1 * (a25 + a29),
+            "A35": self.a35,
+            "A42": a42c - mu * self.s1 * (self.d1 - a1),
+            "A43": a43,
+            "A44": a44c - mu * self.s2 * a2,
+            "I1R": self.i1r(a26, a30),
+            "sinPhi": sp,
+        }
+
+    def i1r(self, a26: float, a30: float) -> float:
+        """Rotor inertia with the acceleration-proportional pivot friction (clamped >= 0)."""
+        v = self.d.i1 + self.i1r_sign * self.mu_abs * self.d.rho1 * (a26 + a30)
+        return v if v > 0.0 else 0.0
+
+    def parts(self, phi: float, phi_dot: float) -> tuple[float, ...]:
+        """(J_ref, T_ref, F0, K, A42, A43, A44): the response (*), F23 = F0 + K phi_dd
+        (B175) and the gear-2 coefficients needed for F12 (B184)."""
+        # Memo of the last point (integrator, accept and outputs ask for it repeatedly).
+        key = (phi, phi_dot, self.direction, self.i1r_sign, self.n1, self.n2, self.s1, self.s2)
+        memo = self.__dict__.get("_memo")
+        if memo is not None and memo[0] == key:
+            return memo[1]
+        out = self._parts(phi, phi_dot)
+        self._memo = (key, out)
+        return out
+
+    def _parts(self, phi: float, phi_dot: float) -> tuple[float, ...]:
+        d = self.d
+        mu, dn, a15c, a16, a31c, a42c, a43, a44c, _, _, _, _ = self._k
+        u1 = self.du1 * phi + d.j1 - self.n1
+        u2 = self.du2 * phi + d.j2 - self.n2
+        a1 = (self.al1_in + self.range1 * u1) * d.rb1_cap
+        a2 = (self.al2_in + self.range2 * u2) * d.rb2_cap
+        a15 = a15c - mu * self.s2 * (self.d2 - a2)
+        a31 = a31c - mu * self.s1 * a1
+        a42 = a42c - mu * self.s1 * (self.d1 - a1)
+        a44 = a44c - mu * self.s2 * a2
+        big_phi = d.phi1c + self.n31 * phi
+        sp, cp = math.sin(big_phi), math.cos(big_phi)
+        m1r = d.m1 * d.rc1
+        x = m1r * (mu * cp - sp)
+        a24 = abs(d.m1 * d.r1 + m1r * (cp + mu * sp)) / dn
+        a28 = abs(mu * d.m1 * d.r1 + x) / dn
+        a25 = abs(m1r * (cp + mu * sp)) / dn
+        a29 = abs(x) / dn
+        a2526 = a25 + a29
+        a32 = mu * d.rho1 * self.om2 * (a24 + a28)
+        a33 = 2.0 * self.mu_abs * d.rho1 * self.om_abs * a2526
+        a34 = mu * d.rho1 * a2526
+        i1r = self.d.i1 + self.i1r_sign * self.mu_abs * d.rho1 * (
+            abs(m1r * (sp - mu * cp)) / dn + abs(m1r * (mu * sp + cp)) / dn
+        )
+        if i1r < 0.0:
+            i1r = 0.0
+        w1 = self.n31 * phi_dot
+        k = (d.i2 * self.n32 - a42 * i1r * self.n31 / a31) / a44
+        f0 = (a42 * (-a32 - a33 * w1 - a34 * w1 * w1 - self.a35 * sp) / a31 - self.t2 * a43) / a44
+        j_ref = d.i3 - a15 * k
+        t_ref = a15 * f0 - self.t3 * a16
+        return j_ref, t_ref, f0, k, a42, a43, a44
+
+    def response(self, phi: float, phi_dot: float) -> tuple[float, float, float]:
+        """(J_ref, T_ref, c_load) of (*) in the current mode."""
+        r = self.parts(phi, phi_dot)
+        return r[0], r[1], 1.0
+
+    def forces(self, phi: float, phi_dot: float, phi_ddot: float) -> tuple[float, float]:
+        """Mesh forces (F12, F23) [N] for a given acceleration (B144/B171 = B183/B184)."""
+        _, _, f0, k, a42, a43, a44 = self.parts(phi, phi_dot)
+        f23 = f0 + k * phi_ddot
+        f12 = (f23 * a44 + self.t2 * a43 - self.d.i2 * self.n32 * phi_ddot) / a42
+        return f12, f23
+
+    def drive_torque(self, phi: float) -> float:
+        """Spin moment on the rotor -A35 sin(Phi) referred to the escape wheel [N.m]."""
+        return -self.n31 * self.a35 * math.sin(self.d.phi1c + self.n31 * phi)
+
+    def mesh_indicators(self, phi: float) -> tuple[float, float]:
+        """Distances to the ends of the current smooth piece (tooth change, pitch point)."""
+        return self.phi_hi - phi, phi - self.phi_lo
+
+    def on_mesh_event(self, phi: float) -> None:
+        """Move to the piece beyond a located tooth-change or pitch-point crossing."""
+        self.set_mode(phi, self.direction)
+
+    def set_direction(self, direction: int, phi: float) -> None:
+        """Friction reversal (eq. 7); the pieces are re-derived for the new direction."""
+        self.set_mode(phi, direction)
+
+    def update_i1r(self, phi_dot: float, phi_ddot: float) -> None:
+        """I1R branch from the accepted acceleration (the report's lagged rule, §4.1)."""
+        v = phi_dot if phi_dot != 0.0 else float(self.direction)
+        self.i1r_sign = 1 if v * phi_ddot >= 0.0 else -1
+
+
+# ---------------------------------------------------------------------------------------
+# Component
+# ---------------------------------------------------------------------------------------
+class _TrainModel:
+    """The train with a held escapement torque, as an EventModel; y = [phi, phi_d, W]."""
+
+    def __init__(self, phys: TrainPhysics, t_esc: float) -> None:
+        self.p = phys
+        self.t_esc = t_esc
+        self.stuck = False
+        self.t_speed_event = -1.0  # first reversal / stick inside the current step
+
+    def accel(self, phi: float, phi_dot: float) -> float:
+        j, t, c = self.p.response(phi, phi_dot)
+        return (t + c * self.t_esc) / j
+
+    def deriv(self, y: list[float]) -> list[float]:
+        if self.stuck:
+            return [0.0, 0.0, 0.0]
+        phi, w = y[0], y[1]
+        a = self.accel(phi, w)
+        # Dissipated power: input power minus rate of stored energy.
+        p_loss = w * (self.t_esc + self.p.drive_torque(phi) - self.p.i_stot * a)
+        return [w, a, p_loss]
+
+    def indicators(self, y: list[float]) -> tuple[float, float, float]:
+        hi, lo = self.p.mesh_indicators(y[0])
+        if self.stuck:
+            return (hi, lo, 0.0)
+        return (hi, lo, self.p.direction * y[1])
+
+    def accept(self, y: list[float], t: float) -> None:
+        if not self.stuck:
+            self.p.update_i1r(y[1], self.accel(y[0], y[1]))
+
+    def event(self, y: list[float], index: int, t: float) -> list[float]:
+        p = self.p
+        if index < 2:
+            p.on_mesh_event(y[0])
+            return y
+        if self.t_speed_event < 0.0:
+            self.t_speed_event = t
+        return self.reverse_or_stick(y)
+
+    def reverse_or_stick(self, y: list[float]) -> list[float]:
+        """Speed crossed zero: reverse if the drive beats friction backwards, else stick."""
+        p = self.p
+        phi = y[0]
+        old = p.direction
+        p.set_direction(-old, phi)
+        if -old * self.accel(phi, 0.0) > 0.0:
+            return y
+        p.set_direction(old, phi)
+        if old * self.accel(phi, 0.0) > 0.0:
+            return [phi, 0.0, y[2]]
+        self.stuck = True
+        return [phi, 0.0, y[2]]
+
+    def try_unstick(self, phi: float) -> None:
+        """At rest: start in whichever direction the net torque beats static friction."""
+        p = self.p
+        for direction in (p.direction, -p.direction):
+            p.set_direction(direction, phi)
+            if direction * self.accel(phi, 0.0) > 0.0:
+                self.stuck = False
+                return
+        self.stuck = True
+
+
+class GearTrain(Component):
+    """M739 train, 1 DOF (cumulative escape-wheel angle), escapement torque as input.
+
+    Regime codes: 0 stuck (static friction), 1 moving forward, 2 moving backward.
+    A master applies an impact by setting ``phi_dot_impact`` and incrementing
+    ``impact_count``; the new speed is taken at once (update_outputs) or at the latest at
+    the start of the next step.  Energy: stored = 1/2 I_STOT phi_dot^2 (B213), external
+    = work of the spin field on the eccentric rotor, A35 (cos Phi - cos Phi_0).
+
+    Port ``escape_wheel``: angle, speed, torque (T_esc in) and the affine response
+    (inertia J_ref, drive T_ref, load_factor c_load, impact_inertia J_stot).
+    """
+
+    REGIME_NAMES = TRAIN_REGIME_NAMES
+    PORTS = {
+        "escape_wheel": {
+            "angle": "phi",
+            "speed": "phi_dot",
+            "torque": "T_esc",
+            "inertia": "J_ref",
+            "drive": "T_ref",
+            "load_factor": "c_load",
+            "impact_inertia": "J_stot",
+        }
+    }
+
+    VARIABLES = (
+        Variable("mu", "parameter", "1", M739.mu, "Coulomb friction, teeth and train pivots"),
+        Variable("spin", "parameter", "rad/s", M739.omega, "fuze spin rate omega"),
+        Variable("indexing", "parameter", "1", INDEXING_PHYSICAL, "0 physical, 1 as-run"),
+        Variable("phi_start", "parameter", "rad", 0.0, "initial cumulative escape-wheel angle"),
+        Variable("phi_dot_start", "parameter", "rad/s", 0.0, "initial escape-wheel speed"),
+        Variable("h_max", "parameter", "s", 1.0e-6, "largest internal RK4 step"),
+        Variable("T_esc", "input", "N.m", 0.0, "escapement moment on the escape wheel"),
+        # Impact inputs are events taken once, not signals held over the step.
+        Variable(
+            "impact_count",
+            "input",
+            "1",
+            0,
+            "incremented by the master at an impact",
+            "Integer",
+            sampled=True,
+        ),
+        Variable(
+            "phi_dot_impact", "input", "rad/s", 0.0, "escape-wheel speed after impact", sampled=True
+        ),
+        Variable("phi", "output", "rad", 0.0, "cumulative escape-wheel angle"),
+        Variable("phi_dot", "output", "rad/s", 0.0, "escape-wheel speed"),
+        Variable("phi_ddot", "output", "rad/s2", 0.0, "escape-wheel acceleration"),
+        Variable("J_ref", "output", "kg.m2", 0.0, "effective inertia at the escape wheel"),
+        Variable("T_ref", "output", "N.m", 0.0, "net train torque at the escape wheel"),
+        Variable("c_load", "output", "1", 1.0, "factor of T_esc in J_ref phi_dd = T_ref + c T_esc"),
+        Variable("J_stot", "output", "kg.m2", 0.0, "frictionless reflected inertia (B213)"),
+        Variable("F12", "output", "N", 0.0, "mesh-1 contact force (any regime)"),
+        Variable("F23", "output", "N", 0.0, "mesh-2 contact force (any regime)"),
+        Variable("FF12", "output", "N", 0.0, "mesh-1 force when unloaded (T_esc = 0), else 0"),
+        Variable("FF23", "output", "N", 0.0, "mesh-2 force when unloaded (T_esc = 0), else 0"),
+        Variable("rotor_angle", "output", "rad", M739.phi1c, "rotor angle Phi"),
+        Variable("s1", "output", "1", 1, "mesh-1 sign, +1 approach, -1 recess", "Integer"),
+        Variable("s2", "output", "1", 1, "mesh-2 sign, +1 approach, -1 recess", "Integer"),
+        Variable("indicator_mesh", "output", "rad", 0.0, "distance to the next mesh event"),
+        Variable("t_event", "output", "s", -1.0, "time of the last reversal or stick"),
+        Variable("external_work", "output", "J", 0.0, "work of the spin on the rotor"),
+        *COMMON_OUTPUTS,
+    )
+
+    def initialize(self, t0: float) -> None:
+        if self.h_max <= 0.0:
+            raise ComponentError("GearTrain: h_max must be positive")
+        self._phys = TrainPhysics(M739, mu=self.mu, omega=self.spin, indexing=int(self.indexing))
+        self._y = [self.phi_start, self.phi_dot_start, 0.0]
+        direction = -1 if self.phi_dot_start < 0.0 else 1
+        self._phys.set_mode(self.phi_start, direction)
+        self._model = _TrainModel(self._phys, self.T_esc)
+        self._seen_impacts = int(self.impact_count)
+        self._cos0 = math.cos(M739.phi1c + self._phys.n31 * self.phi_start)
+        self.t_event = -1.0
+        if self.phi_dot_start == 0.0:
+            self._model.try_unstick(self.phi_start)
+        self._outputs()
+
+    def _apply_inputs(self) -> None:
+        """Take a new impact speed (once per impact_count change) and the held load.
+
+        Idempotent, so it may run in update_outputs and again at the step start.
+        """
+        m = self._model
+        m.t_esc = self.T_esc
+        y = self._y
+        if int(self.impact_count) != self._seen_impacts:
+            self._seen_impacts = int(self.impact_count)
+            y = self._y = [y[0], self.phi_dot_impact, y[2]]
+            if y[1] != 0.0:
+                self._phys.set_direction(1 if y[1] > 0.0 else -1, y[0])
+                m.stuck = False
+        if y[1] == 0.0:
+            m.try_unstick(y[0])
+        elif self._phys.direction * y[1] < 0.0:
+            self._phys.set_direction(1 if y[1] > 0.0 else -1, y[0])
+
+    def update_outputs(self) -> None:
+        # Direct feedthrough: F12, F23, phi_ddot depend on T_esc; an impact sets phi_dot.
+        self._apply_inputs()
+        self._outputs()
+
+    def step(self, t: float, h: float) -> None:
+        self._apply_inputs()
+        m = self._model
+        m.t_speed_event = -1.0
+        self._y, _, _, _ = advance(m, self._y, h, self.h_max)
+        if m.t_speed_event >= 0.0:
+            self.t_event = t + m.t_speed_event
+        self._outputs()
+
+    def _outputs(self) -> None:
+        p, m = self._phys, self._model
+        phi, w, wd = self._y
+        j, tr, c = p.response(phi, w)
+        acc = 0.0 if m.stuck else (tr + c * self.T_esc) / j
+        self.phi, self.phi_dot, self.phi_ddot = phi, w, acc
+        self.J_ref, self.T_ref, self.c_load, self.J_stot = j, tr, c, p.i_stot
+        f12, f23 = p.forces(phi, w, acc)
+        self.F12, self.F23 = f12, f23
+        unloaded = self.T_esc == 0.0
+        self.FF12 = f12 if unloaded else 0.0
+        self.FF23 = f23 if unloaded else 0.0
+        self.rotor_angle = M739.phi1c + p.n31 * phi
+        self.s1, self.s2 = p.s1, p.s2
+        hi, lo = p.mesh_indicators(phi)
+        self.indicator_mesh = hi if p.direction > 0 else lo
+        if m.stuck:
+            self.regime = TRAIN_STUCK
+        else:
+            self.regime = TRAIN_FORWARD if p.direction > 0 else TRAIN_BACKWARD
+        self.stored_energy = 0.5 * p.i_stot * w * w
+        # Work of the spin (centrifugal moment on the eccentric rotor) since the start.
+        self.external_work = p.a35 * (math.cos(M739.phi1c + p.n31 * phi) - self._cos0)
+        self.dissipated_work = wd
+
+    # The snapshot copies the mutable mode and state; the constants (and the memo of
+    # mode-only coefficients) are immutable in use and shared, which keeps it cheap.
+    def get_state(self) -> dict[str, Any]:
+        snap = dict(self.__dict__)
+        if "_phys" in snap:
+            snap["_y"] = list(self._y)
+            snap["_phys"] = dict(self._phys.__dict__)
+            snap["_model"] = {n: v for n, v in self._model.__dict__.items() if n != "p"}
+        return snap
+
+    def set_state(self, state: dict[str, Any]) -> None:
+        self.__dict__.clear()
+        self.__dict__.update(state)
+        if "_phys" in state:
+            self._y = list(state["_y"])
+            phys = TrainPhysics.__new__(TrainPhysics)
+            phys.__dict__.update(state["_phys"])
+            model = _TrainModel.__new__(_TrainModel)
+            model.__dict__.update(state["_model"])
+            model.p = phys
+            self._phys, self._model = phys, model

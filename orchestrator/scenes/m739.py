@@ -1,0 +1,155 @@
+"""The M739 S&A scenes: turns to arm, contact-force maxima and impacts, and their yardstick.
+
+The scene couples two FMUs at the escape-wheel shaft: ``train`` (GearTrain) and ``verge``
+(VergeEscapement), and stops when the cumulative escape-wheel angle reaches the arming
+angle (``scene.stop_when``).  Instance names come from ``[report.options]`` (defaults
+"train" and "verge").
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from components.m739_data import LBF, M739
+from components.verge_escapement import FREE, REGIME_NAMES
+from orchestrator.references import Reference
+from orchestrator.scenario import Scene
+
+RPM_PER_RAD_S = 60.0 / (2.0 * math.pi)
+
+
+def _names(scene: Scene) -> tuple[str, str]:
+    o = scene.analysis_options
+    return o.get("train", "train"), o.get("verge", "verge")
+
+
+def _parameter(scene: Scene, instance: str, name: str) -> float:
+    spec = scene.fmus[instance]
+    if name in spec.parameters:
+        return spec.parameters[name]
+    return scene.component_class(instance).variable(name).start
+
+
+def _arming_angle(scene: Scene) -> float:
+    cond = scene.stop_when
+    return cond.threshold if cond is not None else M739.phi_cut
+
+
+def _q(value: float, unit: str) -> dict[str, Any]:
+    return {"value": float(value), "unit": unit}
+
+
+def analyse(
+    scene: Scene, header: list[str], data: np.ndarray, options: dict[str, Any]
+) -> dict[str, Any]:
+    """Turns to arm (or why not), arming time, force maxima by regime, impacts."""
+    train, verge = _names(scene)
+    col = {name: data[:, i] for i, name in enumerate(header)}
+    t, phi = col["time"], col[f"{train}.phi"]
+    spin = _parameter(scene, train, "spin")
+    phi_cut = _arming_angle(scene)
+    out: dict[str, Any] = {}
+    crossed = np.nonzero(phi >= phi_cut)[0]
+    if len(crossed):
+        k = int(crossed[0])
+        if k == 0 or phi[k] == phi_cut:
+            t_arm = t[k]
+        else:  # a fixed-step master stops past the angle: interpolate within the last step
+            t_arm = t[k - 1] + (t[k] - t[k - 1]) * (phi_cut - phi[k - 1]) / (phi[k] - phi[k - 1])
+        out["armed"] = _q(1.0, "1")
+        out["arming_time"] = _q(t_arm, "s")
+        out["turns_to_arm"] = _q(t_arm * abs(spin) / (2.0 * math.pi), "1")
+    else:
+        out["armed"] = _q(0.0, "1")
+        out["not_armed_reason"] = {"value": _why_not_armed(scene, col, train), "unit": ""}
+    regime = col[f"{verge}.regime"]
+    coupled = regime != FREE
+    for name, mask in (("F23", coupled), ("F12", coupled), ("FF23", ~coupled), ("FF12", ~coupled)):
+        source = col[f"{train}.{name}"]  # F*: coupled motion, FF*: free motion (the report's)
+        out[f"{name}_max"] = _q(float(np.max(source[mask])) if mask.any() else 0.0, "N")
+    out["PN_max"] = _q(float(np.max(col[f"{verge}.PN"])), "N")
+    out["impacts"] = _q(float(col[f"{verge}.impact_count"][-1]), "1")
+    return out
+
+
+def _why_not_armed(scene: Scene, col: dict[str, np.ndarray], train: str) -> str:
+    speed = col[f"{train}.phi_dot"]
+    if len(speed) > 1 and abs(speed[-1]) < 1e-9 and col[f"{train}.regime"][-1] == 0:
+        return f"stalled: the train stopped at t = {col['time'][-1]:.6g} s and friction holds it"
+    return f"stop time {scene.stop:.6g} s reached before the arming angle"
+
+
+def reference(scene: Scene) -> Reference:
+    """The monolithic M739 model with the scene's physics, as the yardstick."""
+    from orchestrator.references.m739 import run_m739
+
+    train, verge = _names(scene)
+    spin = _parameter(scene, train, "spin")
+    result = run_m739(
+        mu=_parameter(scene, train, "mu"),
+        mu1=_parameter(scene, verge, "mu1"),
+        rpm=spin * RPM_PER_RAD_S,
+        e_rest=_parameter(scene, verge, "e_rest"),
+        t_stop=scene.stop,
+        indexing=int(_parameter(scene, train, "indexing")),
+    )
+    s = result.series
+    headline = {
+        "F23_max": result.f23_max,
+        "F12_max": result.f12_max,
+        "FF23_max": result.ff23_max,
+        "FF12_max": result.ff12_max,
+        "PN_max": result.pn_max,
+        "impacts": float(result.impacts),
+    }
+    if result.armed:
+        headline["turns_to_arm"] = result.turns
+        headline["arming_time"] = result.t_arm
+
+    def signals(times: np.ndarray) -> dict[str, np.ndarray]:
+        # The escape-wheel angle is continuous (speeds jump at impacts): it is the trajectory
+        # compared; past the reference's end the comparison holds its last value.
+        return {f"{train}.phi": np.interp(times, s["t"], s["phi"])}
+
+    events = [
+        (te, verge, REGIME_NAMES.get(a, str(a)), REGIME_NAMES.get(b, str(b)))
+        for te, a, b in result.regime_log
+    ]
+    return Reference(headline=headline, signals=signals, events=events)
+
+
+def plot(scene: Scene, header: list[str], data: np.ndarray, path: Path) -> None:
+    """Verge and escape-wheel motion over the first cycles (about 3 teeth)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    train, verge = _names(scene)
+    col = {name: data[:, i] for i, name in enumerate(header)}
+    t = col["time"]
+    window = t <= min(t[-1], 2.2e-3)
+    fig, axes = plt.subplots(3, 1, figsize=(9, 8), sharex=True)
+    ms = t[window] * 1e3
+    axes[0].plot(ms, np.degrees(col[f"{train}.phi"][window]), label="escape wheel (cumulative)")
+    axes[0].set_ylabel("angle [deg]")
+    ax2 = axes[0].twinx()
+    ax2.plot(ms, np.degrees(col[f"{verge}.psi"][window]), color="C1", label="verge")
+    ax2.set_ylabel("verge angle [deg]", color="C1")
+    axes[1].plot(ms, col[f"{train}.phi_dot"][window], label="escape wheel")
+    axes[1].plot(ms, col[f"{verge}.psi_dot"][window], label="verge")
+    axes[1].set_ylabel("speed [rad/s]")
+    axes[1].legend(loc="upper right")
+    axes[2].plot(ms, col[f"{verge}.PN"][window] / LBF, label="PN")
+    axes[2].step(ms, col[f"{verge}.regime"][window], where="post", color="grey", label="regime")
+    axes[2].set_ylabel("PN [lb] / regime")
+    axes[2].set_xlabel("time [ms]")
+    axes[2].legend(loc="upper right")
+    fig.suptitle(f"{scene.name}: verge and escape-wheel motion, first cycles")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
