@@ -513,11 +513,15 @@ class _TrainModel:
     def try_unstick(self, phi: float) -> None:
         """At rest: start in whichever direction the net torque beats static friction."""
         p = self.p
-        for direction in (p.direction, -p.direction):
+        held = p.direction
+        for direction in (held, -held):
             p.set_direction(direction, phi)
             if direction * self.accel(phi, 0.0) > 0.0:
                 self.stuck = False
                 return
+        # Stuck: keep the direction it had, so the outputs (and a master's exchange at
+        # this instant) do not flip between the two friction pieces from call to call.
+        p.set_direction(held, phi)
         self.stuck = True
 
 
@@ -631,6 +635,10 @@ class GearTrain(Component):
         self._apply_inputs()
         m = self._model
         m.t_speed_event = -1.0
+        if m.stuck and self._y[1] == 0.0:
+            # Held at rest by static friction under held inputs: nothing moves in this step.
+            self._outputs()
+            return
         self._y, _, _, _ = advance(m, self._y, h, self.h_max)
         if m.t_speed_event >= 0.0:
             self.t_event = t + m.t_speed_event

@@ -736,6 +736,12 @@ class VergeEscapement(Component):
             # Wheel at rest: friction signs follow the motion that starts (or stick).
             y = core.decide_direction(y, 0.0, self._held.direction)
         y = self._resync_events(y)
+        if core.train_stuck and core.coupled:
+            # The wheel is held by static friction and the verge rides on it: at rest.
+            self._y = y
+            self._g_end = core.indicators(y)
+            self._outputs(y)
+            return
         y, _, _, _ = advance(core, y, h, self.h_max)
         if core.halted:
             raise ComponentError(f"VergeEscapement: {core.fault}")

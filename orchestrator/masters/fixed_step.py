@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 
-from orchestrator.recorder import Recorder, StepStats
+from orchestrator.recorder import Recorder, RegimeLog, StepStats
 from orchestrator.scenario import Scene
 from orchestrator.system import CoupledSystem
 
@@ -34,6 +34,7 @@ def _run(
     m = len(system.instances)
     every = scene.record_every
     recorder.row(system.record_row(scene.start))
+    log = RegimeLog(system, scene, recorder)
     t = scene.start
     for k in range(n):
         hk = h if k < n - 1 else scene.stop - t
@@ -50,6 +51,7 @@ def _run(
         t = scene.start + (k + 1) * h if k < n - 1 else scene.stop
         stats.steps += 1
         stats.do_steps += m
+        stats.events += log.update(t)
         stop = system.stop_indicator()
         done = stop is not None and stop <= 0.0
         if (k + 1) % every == 0 or k == n - 1 or done:

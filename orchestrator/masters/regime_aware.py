@@ -23,7 +23,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from orchestrator.errors import RunError
-from orchestrator.recorder import Recorder, StepStats
+from orchestrator.recorder import Recorder, RegimeLog, StepStats
 from orchestrator.scenario import Scene, component_class
 from orchestrator.system import CoupledSystem
 
@@ -69,11 +69,15 @@ class RegimeAwareMaster:
         self.system, self.scene, self.recorder, self.stats = system, scene, recorder, stats
         self.cfg = Settings.of(scene)
         self.names = system.names
-        self.regime_names = [
-            getattr(component_class(scene.fmus[n].fmu), "REGIME_NAMES", {}) for n in self.names
-        ]
-        # Exchanged Real signals: (instance, slot) of every connection source.
-        self.signals = sorted({src for feed in system.feeds for src in feed.real_sources})
+        self.log = RegimeLog(system, scene, recorder)
+        # Exchanged Real signals held over a step: (instance, slot) of their sources.  Inputs
+        # that are sampled as a state at the step start carry no hold error of their own.
+        held = set()
+        for c, src in zip(scene.connections, system.connection_sources, strict=True):
+            target = component_class(scene.fmus[c.target[0]].fmu).variable(c.target[1])
+            if src is not None and not target.sampled:
+                held.add(src)
+        self.signals = sorted(held)
         self.scale = {s: 0.0 for s in self.signals}
 
     # -- helpers ----------------------------------------------------------------------
@@ -152,15 +156,8 @@ class RegimeAwareMaster:
         )
 
     def log_switches(self, t: float, before: _Snapshot) -> int:
-        count = 0
-        for i, (r0, r1) in enumerate(zip(before.regimes, self.system.regimes(), strict=True)):
-            if r0 != r1:
-                names = self.regime_names[i]
-                self.recorder.event(
-                    t, self.names[i], names.get(r0, str(r0)), names.get(r1, str(r1))
-                )
-                count += 1
-        return count
+        self.log.last = before.regimes
+        return self.log.update(t)
 
     # -- main loop --------------------------------------------------------------------
     def run(self, progress) -> None:
@@ -215,8 +212,13 @@ class RegimeAwareMaster:
                 return
 
     def _attempt(self, t: float, h: float, before: _Snapshot, state: list[Any]):
-        """Trial steps from t until one is accepted; returns (h, switch time or None)."""
+        """Trial steps from t until one is accepted; returns (h, switch time or None).
+
+        A signal that jumps without a reported event (its change does not shrink with the
+        step) is a discontinuity: the step that contains it is accepted as a switch.
+        """
         cfg = self.cfg
+        last_ratio = None
         for _ in range(200):
             self.trial(t, h)
             te = self.switch_time(t, h, before)
@@ -226,9 +228,14 @@ class RegimeAwareMaster:
                 # End the retaken step just past the located instant.
                 h = max(te - t + 0.5 * cfg.event_tolerance, cfg.min_step)
                 self._rollback(state)
+                last_ratio = None
                 continue
             ratio = self.error_ratio(before)
             if ratio > 1.0 and h > cfg.min_step:
+                if last_ratio is not None and ratio > 0.5 * last_ratio:
+                    self.stats.extra["jumps"] = self.stats.extra.get("jumps", 0) + 1
+                    return h, t + h  # a jump, not a smooth change: land after it
+                last_ratio = ratio
                 h = max(cfg.min_step, h * max(0.2, 0.9 / ratio))
                 self._rollback(state)
                 continue

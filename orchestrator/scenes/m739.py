@@ -79,7 +79,9 @@ def analyse(
 def _why_not_armed(scene: Scene, col: dict[str, np.ndarray], train: str) -> str:
     speed = col[f"{train}.phi_dot"]
     if len(speed) > 1 and abs(speed[-1]) < 1e-9 and col[f"{train}.regime"][-1] == 0:
-        return f"stalled: the train stopped at t = {col['time'][-1]:.6g} s and friction holds it"
+        moving = np.nonzero(np.abs(speed) >= 1e-9)[0]
+        t_stop = col["time"][moving[-1] + 1] if len(moving) else col["time"][0]
+        return f"stalled: the train is held by friction from t = {t_stop:.6g} s on"
     return f"stop time {scene.stop:.6g} s reached before the arming angle"
 
 

@@ -1,0 +1,95 @@
+"""The M739 scene through FMUs and the regime-aware master, against the report and the
+monolithic reference (Lowen & Tepper 1982; note models/sa_verge_escapement.md)."""
+
+from __future__ import annotations
+
+import csv
+from pathlib import Path
+
+import pytest
+
+from components.m739_data import LBF
+from orchestrator.run import run_scene
+from orchestrator.scenario import load_scene
+
+SCENE = Path(__file__).resolve().parent.parent / "scenarios" / "m739.toml"
+
+
+def run(tmp_path: Path, fmu_cache: Path, name: str, **overrides):
+    scene = load_scene(SCENE, overrides)
+    return run_scene(scene, output_dir=tmp_path / name, cache_dir=fmu_cache, show_progress=False)
+
+
+@pytest.fixture(scope="module")
+def default_run(tmp_path_factory, fmu_cache):
+    return run(tmp_path_factory.mktemp("m739"), fmu_cache, "default")
+
+
+def test_report_numbers(default_run) -> None:
+    r = default_run
+    assert r.status == "completed" and r.value("armed") == 1.0
+    assert r.value("turns_to_arm") == pytest.approx(25.78, rel=0.01)
+    assert r.value("F23_max") / LBF == pytest.approx(3.24, rel=0.02)
+    assert r.value("F12_max") / LBF == pytest.approx(11.41, rel=0.02)
+    assert r.value("FF23_max") / LBF == pytest.approx(2.93, rel=0.02)
+    assert r.value("FF12_max") / LBF == pytest.approx(10.94, rel=0.02)
+    assert r.value("PN_max") / LBF == pytest.approx(0.66, rel=0.05)
+    assert abs(r.value("impacts") - 181) <= 2
+
+
+def test_cosimulation_matches_the_monolithic_reference(default_run) -> None:
+    acc = default_run.accuracy
+    assert acc["headline_error.turns_to_arm"] < 1e-4
+    assert acc["headline_error.impacts"] == 0.0
+    assert acc["event_time_error"] < 1e-5
+    assert default_run.value("energy_residual") < 1e-3
+
+
+def test_regime_log_and_outputs(default_run) -> None:
+    r = default_run
+    with open(r.output_dir / "events.csv") as f:
+        events = list(csv.DictReader(f))
+    transitions = {(e["from"], e["to"]) for e in events if e["subsystem"] == "verge"}
+    assert ("coupled-entrance", "free") in transitions
+    assert ("free", "coupled-exit") in transitions
+    # Two switches per impact-to-impact half cycle: 2 x 181 plus the start and the end.
+    assert 360 <= sum(e["subsystem"] == "verge" for e in events) <= 366
+    assert r.stats.rollbacks > 0 and r.stats.events >= 360
+    assert (r.output_dir / "m739.png").stat().st_size > 10_000
+    # The run stops on the arming angle, within the event tolerance (1e-10 s) times the
+    # wheel speed (below 1000 rad/s).
+    overshoot = r.signal("train.phi")[-1] - 1485.0 * 3.141592653589793 / 180.0
+    assert 0.0 <= overshoot < 1e-7
+
+
+def test_error_shrinks_as_the_tolerance_tightens(tmp_path, fmu_cache, default_run) -> None:
+    coarse = run(tmp_path, fmu_cache, "coarse", **{"master.tolerance": 1e-2})
+    errors = [
+        coarse.accuracy["headline_error.turns_to_arm"],
+        default_run.accuracy["headline_error.turns_to_arm"],
+    ]
+    assert errors[1] < errors[0] / 3.0, errors
+    assert coarse.stats.steps < default_run.stats.steps
+
+
+def test_jammed_train_does_not_arm_and_says_why(tmp_path, fmu_cache) -> None:
+    r = run(
+        tmp_path,
+        fmu_cache,
+        "jam",
+        **{
+            "fmus.train.parameters.mu": 0.3,
+            "fmus.verge.parameters.mu": 0.3,
+            "fmus.verge.parameters.mu1": 0.3,
+        },
+    )
+    assert r.status in ("completed", "failed")
+    assert r.headline["armed"]["value"] == 0.0 or r.status == "failed"
+    reason = r.headline.get("not_armed_reason", {}).get("value", r.message)
+    assert "stall" in reason or "stuck" in reason or "lock" in reason, reason
+
+
+def test_too_short_a_run_does_not_arm(tmp_path, fmu_cache) -> None:
+    r = run(tmp_path, fmu_cache, "short", **{"scene.stop": "2 ms"})
+    assert r.status == "completed" and r.value("armed") == 0.0
+    assert "stop time" in r.headline["not_armed_reason"]["value"]
