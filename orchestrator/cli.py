@@ -58,7 +58,7 @@ def main(argv: list[str] | None = None) -> int:
     p.set_defaults(handler=_precision)
 
     p = sub.add_parser("bench", help="run a benchmark (prints ratios against its baseline)")
-    p.add_argument("name", choices=["overhead"])
+    p.add_argument("name", choices=["overhead", "m739"])
     p.set_defaults(handler=_bench)
 
     p = sub.add_parser("report", help="print the summary of a finished run")
