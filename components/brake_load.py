@@ -20,6 +20,11 @@ from components.press_feed_data import APP_H_J_O5, LBF_IN, ROLLER_RADIUS
 REGIME_STICK = 0
 REGIME_SLIP_FORWARD = 1
 REGIME_SLIP_BACKWARD = 2
+REGIME_NAMES = {
+    REGIME_STICK: "stick",
+    REGIME_SLIP_FORWARD: "slip-forward",
+    REGIME_SLIP_BACKWARD: "slip-backward",
+}
 
 
 def slip_direction(torque: float, brake_torque: float) -> int:
@@ -46,7 +51,15 @@ def breakaway_margin(torque: float, brake_torque: float) -> float:
 
 
 class BrakeLoad(Component):
-    """Roller shaft + strip + constant dry friction; input: the clutch torque."""
+    """Roller shaft + strip + constant dry friction; input: the clutch torque.
+
+    Port ``shaft`` (angle, speed out; torque in) joins the clutch's inner race.
+    ``ind_brake`` is the break-away margin while stuck and the speed while slipping: its
+    zero is the next regime change.  ``input_work`` is port work from the clutch, inside
+    the scene, so it is not ``external_work``.
+    """
+
+    PORTS = {"shaft": {"angle": "angle", "speed": "speed", "torque": "torque"}}
 
     VARIABLES = (
         Variable("j", "parameter", "kg.m2", APP_H_J_O5, "shaft + referred strip inertia J_o5"),
@@ -61,6 +74,8 @@ class BrakeLoad(Component):
         Variable("breakaway", "output", "N.m", 0.0, "|torque| - T_b; zero while stuck = slip"),
         Variable("input_work", "output", "J", 0.0, "work done by the input torque"),
         Variable("event_time", "output", "s", -1.0, "time of the last stop (slip -> stick)"),
+        Variable("t_event", "output", "s", -1.0, "time of the last regime change"),
+        Variable("ind_brake", "output", "1", 0.0, "|T| - T_b if stuck, speed if slipping"),
         *COMMON_OUTPUTS,
     )
 
@@ -81,6 +96,7 @@ class BrakeLoad(Component):
         self.feed_length = self.roller_radius * (self.angle - self.angle0)
         self.breakaway = breakaway_margin(self.torque, self.brake_torque)
         self.stored_energy = 0.5 * self.j * self.speed * self.speed
+        self.ind_brake = self.breakaway if self.regime == REGIME_STICK else self.speed
 
     def _advance(self, s: float) -> None:
         """Move along the current regime's parabola for a time s."""
@@ -98,13 +114,14 @@ class BrakeLoad(Component):
                 self.regime = slip_direction(self.torque, self.brake_torque)
                 if self.regime == REGIME_STICK:
                     break
+                self.t_event = t + (h - left)  # break-away: the held torque exceeds T_b
             a = shaft_acceleration(self.regime, self.torque, self.brake_torque, self.j)
             if self.speed * a < 0.0 and -self.speed / a < left:
                 stop = -self.speed / a
                 self._advance(stop)
                 self.speed = 0.0  # exact stop
                 left -= stop
-                self.event_time = t + (h - left)
+                self.event_time = self.t_event = t + (h - left)
                 self.regime = slip_direction(self.torque, self.brake_torque)
                 if self.regime == REGIME_STICK:
                     break

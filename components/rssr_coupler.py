@@ -37,6 +37,7 @@ from components.rssr_kinematics import ExactRSSR, FourierRocker, rocker_extremes
 
 REGIME_RETURN = 0  # rocker moving back (theta4 decreasing)
 REGIME_FORWARD = 1  # rocker on the feed stroke (theta4 increasing)
+REGIME_NAMES = {REGIME_RETURN: "return", REGIME_FORWARD: "forward"}
 
 
 # -- coupler properties (§1.3) -----------------------------------------------------------
@@ -194,10 +195,17 @@ class CrankCouplerDrive(Component):
     Input ``torque``: the torque the clutch transmits (>= 0); it loads the rocker against
     the feed stroke.  Internal event: rocker reversal (``speed`` = 0), located exactly;
     it changes only the reported regime, not the equations.
+
+    Port ``rocker`` (angle, speed out; torque in) joins the clutch's outer race.  The crank
+    work is ``external_work`` (brought in from outside the scene, see components.base);
+    ``input_work`` is the same number under its older name.
     """
 
+    PORTS = {"rocker": {"angle": "angle", "speed": "speed", "torque": "torque"}}
+
     VARIABLES = (
-        Variable("rpm", "parameter", "1", 200.0, "crank speed [rev/min]"),
+        Variable("rpm", "parameter", "1", 200.0, "crank speed [rev/min] (if crank_speed = 0)"),
+        Variable("crank_speed", "parameter", "rad/s", 0.0, "crank speed; 0: take rpm"),
         Variable("phi1_0", "parameter", "rad", 0.0, "crank angle at t0 (if start_at_max = 0)"),
         Variable("start_at_max", "parameter", "1", 1.0, "1: start at the rigid rocker maximum"),
         Variable("a1", "parameter", "m", _T1.a1, "crank length"),
@@ -233,7 +241,10 @@ class CrankCouplerDrive(Component):
         Variable("strain_b", "output", "1", 0.0, "outer-fibre strain at the bend B"),
         Variable("phi4_max", "output", "rad", 0.0, "thesis phi4 at theta4 = 0"),
         Variable("input_work", "output", "J", 0.0, "work done by the crank drive"),
+        Variable("external_work", "output", "J", 0.0, "work done by the crank drive"),
         Variable("event_time", "output", "s", -1.0, "time of the last rocker reversal"),
+        Variable("t_event", "output", "s", -1.0, "time of the last rocker reversal"),
+        Variable("ind_rocker_speed", "output", "rad/s", 0.0, "rocker speed; zero = reversal"),
         *COMMON_OUTPUTS,
     )
 
@@ -252,7 +263,7 @@ class CrankCouplerDrive(Component):
         )
         linkage = RSSRLinkage(self.a1, self.a3, self.a4, self.s1, self.s2, self.s3)
         return build_drive_model(
-            self.rpm,
+            self.crank_rpm(),
             linkage,
             coupler,
             j_o4=self.j_o4,
@@ -261,8 +272,12 @@ class CrankCouplerDrive(Component):
             rigid=self.rigid > 0.5,
         ), coupler
 
+    def crank_rpm(self) -> float:
+        """Crank speed in rev/min: crank_speed when given, else rpm."""
+        return self.crank_speed / RPM if self.crank_speed > 0.0 else self.rpm
+
     def initialize(self, t0: float) -> None:
-        if self.rpm <= 0.0 or self.max_step <= 0.0:
+        if self.crank_rpm() <= 0.0 or self.max_step <= 0.0:
             raise ComponentError("CrankCouplerDrive: rpm and max_step must be positive")
         self._m, coupler = self._build()
         self._gauge, self._at_b = strain_factors(coupler)
@@ -277,6 +292,15 @@ class CrankCouplerDrive(Component):
         self.input_work = self.dissipated_work = 0.0
         self.phi4_max = self._m.phi4_max
         self.update_outputs()
+        if self.start_at_max > 0.5:
+            # At the located extreme the speed is rounding noise of either sign; a few ulps
+            # on the crank make it leave forward, so the clutch does not see a spurious
+            # return (and disengage) in its first step.
+            for _ in range(64):
+                if self.speed >= 0.0:
+                    break
+                self.phi1_0 = math.nextafter(self.phi1_0, math.inf)
+                self.update_outputs()
         self.regime = REGIME_FORWARD if self.speed >= 0.0 else REGIME_RETURN
 
     def update_outputs(self) -> None:
@@ -287,6 +311,9 @@ class CrankCouplerDrive(Component):
         self.strain = self._gauge * self.q
         self.strain_b = self._at_b * self.q
         self.stored_energy = coupler_energy(m, self.q, self.q_dot, thd)
+        self.ind_rocker_speed = thd
+        self.external_work = self.input_work
+        self.t_event = self.event_time
 
     # RK4 on (q, q', W_in, W_diss); the input torque is held over the step.
     def _rk4(self, t: float, y: tuple[float, float, float, float], h: float):

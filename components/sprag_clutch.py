@@ -25,6 +25,7 @@ from components.press_feed_data import C_NL, K_SP, N_DAMP, TABLE4, SpragGeometry
 
 REGIME_OVERRUN = 0
 REGIME_ENGAGED = 1
+REGIME_NAMES = {REGIME_OVERRUN: "overrun", REGIME_ENGAGED: "engaged"}
 MODEL_LUMPED = 0
 MODEL_HERTZ = 1
 
@@ -227,7 +228,15 @@ class SpragClutch(Component):
 
     During a step the race angles advance with their held speeds (consistent with the held
     inputs), so the disengagement instant is a linear root, located exactly.
+
+    Ports ``outer`` (rocker side) and ``inner`` (roller side) take the race angle and speed
+    and give the transmitted torque, which loads the rocker and drives the roller.
     """
+
+    PORTS = {
+        "outer": {"angle": "angle_outer", "speed": "speed_outer", "torque": "torque"},
+        "inner": {"angle": "angle_inner", "speed": "speed_inner", "torque": "torque"},
+    }
 
     VARIABLES = (
         Variable("model", "parameter", "1", MODEL_LUMPED, "0: lumped K; 1: two-point Hertz"),
@@ -256,6 +265,8 @@ class SpragClutch(Component):
         Variable("contact_force", "output", "N", 0.0, "spring part of N_h per sprag"),
         Variable("k_eff", "output", "N.m", 0.0, "stiffness in use [N.m/rad^1.5]"),
         Variable("event_time", "output", "s", -1.0, "time of the last regime change"),
+        Variable("t_event", "output", "s", -1.0, "time of the last regime change"),
+        Variable("ind_clutch", "output", "1", 0.0, "w if engaged, rel. speed if not"),
         *COMMON_OUTPUTS,
     )
 
@@ -299,6 +310,8 @@ class SpragClutch(Component):
         w = rel - self._lock
         self.windup, self.windup_rate = w, wd
         self.event_indicator = w if self.regime == REGIME_ENGAGED else wd
+        self.ind_clutch = self.event_indicator
+        self.t_event = self.event_time
         self.torque = self._torque(w, wd) if self.regime == REGIME_ENGAGED else 0.0
         self.contact_force = self.k_eff * max(w, 0.0) ** 1.5 / self._lever
         self.stored_energy = clutch_energy(w, self.k_eff)

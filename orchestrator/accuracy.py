@@ -44,11 +44,13 @@ def compare(
         out["trajectory_error"] = worst
     if reference.events:
         out["event_time_error"] = _event_time_error(events, reference.events)
+        out["event_count_difference"] = float(len(events) - len(reference.events))
     return out
 
 
 def _event_time_error(run_events, ref_events) -> float:
-    """Events matched in order within each (subsystem, from, to); unmatched ones count as inf."""
+    """Events matched in order within each (subsystem, from, to); NaN when the counts differ
+    (then ``event_count_difference`` says by how many)."""
     groups: dict[tuple[str, str, str], list[float]] = {}
     for t, sub, a, b in ref_events:
         groups.setdefault((sub, a, b), []).append(t)
@@ -59,6 +61,6 @@ def _event_time_error(run_events, ref_events) -> float:
     for key, ref_times in groups.items():
         run_times = seen.get(key, [])
         if len(run_times) != len(ref_times):
-            return float("inf")
+            return float("nan")
         worst = max(worst, max(abs(x - y) for x, y in zip(run_times, ref_times, strict=True)))
     return worst

@@ -57,6 +57,12 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--dask", metavar="ADDRESS", help="run the sweep on this Dask scheduler")
     p.set_defaults(handler=_precision)
 
+    p = sub.add_parser("stability", help="run the stability suite (scenarios/stability/)")
+    p.add_argument("--output", type=Path, default=Path("runs") / "stability")
+    p.add_argument("--workers", type=int, help="local processes (default: one per core)")
+    p.add_argument("--dask", metavar="ADDRESS", help="run the cases on this Dask scheduler")
+    p.set_defaults(handler=_stability)
+
     p = sub.add_parser("bench", help="run a benchmark (prints ratios against its baseline)")
     p.add_argument("name", choices=["overhead", "m739"])
     p.set_defaults(handler=_bench)
@@ -170,6 +176,15 @@ def _precision(args: argparse.Namespace) -> int:
     out = Path(rows[0].result.job.output_dir).parent if rows else args.output
     print(f"report in {out}/work_precision.md (.csv, .png)")
     return 0
+
+
+def _stability(args: argparse.Namespace) -> int:
+    from orchestrator.stability import run_suite
+
+    rows = run_suite(out_dir=args.output, workers=args.workers, dask_address=args.dask)
+    print((args.output / "stability.md").read_text())
+    unstable = [r for r in rows if r.master == "regime-aware" and not r.stable and not r.diagnosis]
+    return 1 if unstable else 0
 
 
 def _bench(args: argparse.Namespace) -> int:

@@ -194,16 +194,14 @@ def regime_sequences(
 ) -> list[list[int]]:
     """Regimes entered within each crank cycle [k P, (k+1) P), in order (repeats merged)."""
     seqs: list[list[int]] = [[] for _ in range(n_cycles)]
-    for k, (t, r) in enumerate(transitions):
+    for t, r in transitions:
         c = int(math.floor(t / period + 1e-12))
-        if k == 0:
-            c = 0
         if 0 <= c < n_cycles and (not seqs[c] or seqs[c][-1] != r):
             seqs[c].append(r)
     return seqs
 
 
-def decay_ratios(times: np.ndarray, windup: np.ndarray, feeding: np.ndarray) -> list[float]:
+def decay_ratios(windup: np.ndarray, feeding: np.ndarray) -> list[float]:
     """App. K peak-to-trough ratios of the windup during the first feed in the samples."""
     idx = np.nonzero(feeding)[0]
     if len(idx) < 3:
@@ -285,7 +283,7 @@ def analyse(
     for name, value in timing.items():
         out[name] = _q(value, "rad" if name.endswith("angle") else "1")
     if options.get("decay_ratios", False):
-        ratios = decay_ratios(t, windup, (cycle_of == n - 1) & (regime == FEED))
+        ratios = decay_ratios(windup, (cycle_of == n - 1) & (regime == FEED))
         if ratios:
             out["decay_ratio"] = _q(np.mean(ratios[:DECAY_PEAKS]), "1")
     ext = f"{fs.drive}.external_work"
@@ -482,7 +480,7 @@ def reference_quantities(res, fs: FeedScene, duration: float, options: dict[str,
     out.update(regime_timing(trans, (n - 1) * fs.period, n * fs.period, fs.omega, res.phi1_0))
     if options.get("decay_ratios", False):
         last = (s["t"] >= (n - 1) * fs.period) & (s["t"] < n * fs.period)
-        ratios = decay_ratios(s["t"], s["windup"], last & _feeding_mask(s["t"], trans))
+        ratios = decay_ratios(s["windup"], last & _feeding_mask(s["t"], trans))
         if ratios:
             out["decay_ratio"] = float(np.mean(ratios[:DECAY_PEAKS]))
     return out
