@@ -102,7 +102,8 @@ def _run(args: argparse.Namespace) -> int:
         f"scene {scene.name}: {result.status}" + (f" — {result.message}" if result.message else "")
     )
     for name, q in result.headline.items():
-        print(f"  {name:32s} {q['value']:.10g} {q['unit']}")
+        value = q["value"] if isinstance(q["value"], str) else f"{q['value']:.10g}"
+        print(f"  {name:32s} {value} {q['unit']}")
     for name, value in result.accuracy.items():
         print(f"  {name:32s} {value:.4g}")
     s = result.stats

@@ -219,6 +219,7 @@ class RegimeAwareMaster:
         """
         cfg = self.cfg
         last_ratio = None
+        stalled = 0
         for _ in range(200):
             self.trial(t, h)
             te = self.switch_time(t, h, before)
@@ -232,9 +233,12 @@ class RegimeAwareMaster:
                 continue
             ratio = self.error_ratio(before)
             if ratio > 1.0 and h > cfg.min_step:
-                if last_ratio is not None and ratio > 0.5 * last_ratio:
+                # Two shrinks in a row that leave the change as large: a jump, not a smooth
+                # change (one shrink is not proof: a long step may span an oscillation).
+                stalled = stalled + 1 if last_ratio is not None and ratio > 0.5 * last_ratio else 0
+                if stalled >= 2:
                     self.stats.extra["jumps"] = self.stats.extra.get("jumps", 0) + 1
-                    return h, t + h  # a jump, not a smooth change: land after it
+                    return h, t + h  # land after the jump and treat it as a switch
                 last_ratio = ratio
                 h = max(cfg.min_step, h * max(0.2, 0.9 / ratio))
                 self._rollback(state)

@@ -1,0 +1,52 @@
+"""Stability suite: the regime-aware master's row of every stiff or extreme case."""
+
+from __future__ import annotations
+
+import pytest
+
+from orchestrator.stability import case_files, run_suite
+
+EXPECTED_STABLE = {
+    "m739_friction_zero",
+    "m739_jam",
+    "m739_spin_x4",
+    "two_inertias_huge_step",
+}
+
+
+@pytest.fixture(scope="module")
+def rows(tmp_path_factory, fmu_cache):
+    import os
+
+    os.environ["MECHCOSIM_FMU_CACHE"] = str(fmu_cache)
+    out = tmp_path_factory.mktemp("stability")
+    return {r.case: r for r in run_suite(out_dir=out, masters=("regime-aware",), workers=2)}
+
+
+def test_every_case_has_a_row(rows) -> None:
+    assert set(rows) == {f.stem for f in case_files()}
+
+
+@pytest.mark.parametrize("case", sorted(EXPECTED_STABLE))
+def test_regime_aware_master_is_stable_within_its_stated_error(rows, case) -> None:
+    row = rows[case]
+    assert row.status == "completed", row.diagnosis
+    assert row.stable, row.diagnosis
+
+
+def test_elastic_impacts_stay_energy_consistent(rows) -> None:
+    # Restitution 1 makes the tooth bounce; the run keeps its energy balance, but its
+    # trajectory departs from the reference's (see the issue note): not claimed stable.
+    row = rows["m739_elastic_impacts"]
+    assert row.status == "completed"
+    assert row.energy_residual < 1e-3
+
+
+def test_jammed_mechanism_says_why(tmp_path, fmu_cache) -> None:
+    from orchestrator.run import run_scene
+    from orchestrator.scenario import load_scene
+
+    scene = load_scene(next(f for f in case_files() if f.stem == "m739_jam"))
+    result = run_scene(scene, output_dir=tmp_path, cache_dir=fmu_cache, show_progress=False)
+    assert result.value("armed") == 0.0
+    assert "held by friction" in result.headline["not_armed_reason"]["value"]
