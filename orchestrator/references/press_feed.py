@@ -678,14 +678,18 @@ def decay_ratios_from_series(res: FeedResult, cycle: int = 0) -> list[float]:
     t_on = next(te for te, to in feed if to == FEED)
     t_off = next(te for te, to in feed if te > t_on)
     sel = (s["t"] > t_on) & (s["t"] < t_off)
-    w = s["windup"][sel]
+    return peak_to_trough_ratios(s["windup"][sel])
+
+
+def peak_to_trough_ratios(w: np.ndarray) -> list[float]:
+    """Ratios of successive peak-to-trough ranges of a decaying oscillation (App. K)."""
     d = np.diff(w)
     ext = [
         (w[i], 1 if d[i - 1] > 0 else -1)
         for i in range(1, len(d))
         if (d[i - 1] > 0 >= d[i]) or (d[i - 1] < 0 <= d[i])
     ]
-    maxima = [v for v, kk in ext if kk > 0]
-    minima = [v for v, kk in ext if kk < 0]
+    maxima = [v for v, kind in ext if kind > 0]
+    minima = [v for v, kind in ext if kind < 0]
     ranges = [maxima[i] - minima[i] for i in range(min(len(maxima), len(minima)))]
     return [ranges[i + 1] / ranges[i] for i in range(len(ranges) - 1)]

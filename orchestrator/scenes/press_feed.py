@@ -39,6 +39,7 @@ from components.rssr_kinematics import ExactRSSR, rocker_extremes
 from components.sprag_clutch import MODEL_LUMPED, REGIME_ENGAGED, SpragClutch
 from components.sprag_clutch import REGIME_NAMES as CLUTCH_NAMES
 from orchestrator.references import Reference
+from orchestrator.references.press_feed import peak_to_trough_ratios
 from orchestrator.scenario import Scene
 
 WINDUP, FEED, UNWIND, OVERRUN = 1, 2, 3, 4
@@ -209,17 +210,7 @@ def decay_ratios(windup: np.ndarray, feeding: np.ndarray) -> list[float]:
     end = idx[0]
     while end + 1 < len(feeding) and feeding[end + 1]:
         end += 1
-    w = windup[idx[0] : end + 1]
-    d = np.diff(w)
-    ext = [
-        (w[i], 1 if d[i - 1] > 0 else -1)
-        for i in range(1, len(d))
-        if (d[i - 1] > 0 >= d[i]) or (d[i - 1] < 0 <= d[i])
-    ]
-    maxima = [v for v, kind in ext if kind > 0]
-    minima = [v for v, kind in ext if kind < 0]
-    ranges = [maxima[i] - minima[i] for i in range(min(len(maxima), len(minima)))]
-    return [ranges[i + 1] / ranges[i] for i in range(len(ranges) - 1)]
+    return peak_to_trough_ratios(windup[idx[0] : end + 1])
 
 
 def _complete_cycles(duration: float, period: float) -> int:
