@@ -99,7 +99,16 @@ class RegimeAwareMaster:
         for i in range(len(system.instances)):
             system.step(i, t, h)
         system.read_all()
+        self.refresh()
         self.stats.do_steps += len(system.instances)
+
+    def refresh(self) -> None:
+        """Give every FMU the others' newest outputs, so that outputs which depend on
+        inputs (indicators among them) are those of one consistent instant."""
+        system = self.system
+        for i in range(len(system.instances)):
+            system.feed(i)
+        system.read_all()
 
     def switch_time(self, t: float, h: float, before: _Snapshot) -> float | None:
         """Earliest switching instant inside (t, t+h], or None if nothing switched.
@@ -117,11 +126,15 @@ class RegimeAwareMaster:
             fired = after_regimes[i] != before.regimes[i]
             if watch.t_event is not None:
                 te = system.values[i][watch.t_event]
-                if t < te <= t + h * (1 + 1e-12) and (fired or te > t):
+                if t < te <= t + h * (1 + 1e-12):
                     best = te if best is None else min(best, te)
                     continue
+                if fired and te == t:
+                    continue  # switched at the step start, on inputs that crossed by t
             for g0, g1 in zip(before.indicators[i], after_ind[i], strict=True):
-                if (g0 > 0.0) != (g1 > 0.0) and g0 != g1:
+                # A crossing leaves one strict sign; an indicator starting at zero (the
+                # switch it marks has just happened) does not switch again by leaving it.
+                if g0 > 0.0 >= g1 or g0 < 0.0 <= g1:
                     te = t + h * g0 / (g0 - g1)
                     best = te if best is None else min(best, te)
             if fired and best is None:
@@ -174,6 +187,7 @@ class RegimeAwareMaster:
             if target is not None:
                 h = min(h, target - t + 0.5 * cfg.event_tolerance)
             state = system.get_state()
+            self.refresh()
             before = self.snapshot()
             try:
                 h, te = self._attempt(t, h, before, state)
@@ -185,6 +199,7 @@ class RegimeAwareMaster:
             stats.steps += 1
             if te is None:
                 ratio = self.error_ratio(before)
+                stats.events += self.log_switches(t - h, before)  # switched at the start
                 recorder.row(system.record_row(t))
                 grow = 4.0 if ratio == 0.0 else min(4.0, max(0.2, 0.9 / ratio))
                 h = min(cfg.max_step, h * grow)
