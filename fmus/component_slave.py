@@ -118,8 +118,7 @@ class ComponentSlave(Fmi2Slave):
     def do_step(self, current_time: float, step_size: float) -> bool:
         try:
             if self._feedthrough_stale:
-                self.component.update_outputs()
-                self._feedthrough_stale = False
+                self._refresh()
             self.component.step(current_time, step_size)
         except Exception as exc:  # the FMU cannot go on: say why through the FMI logger
             self.log(

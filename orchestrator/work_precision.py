@@ -25,6 +25,7 @@ from orchestrator.sweep import Job, JobResult, run_jobs
 
 STEP_FACTORS = (8.0, 4.0, 2.0, 1.0, 0.5, 0.25)
 TOLERANCES = (1e-2, 3e-3, 1e-3, 3e-4, 1e-4)
+COUNTERS = ("steps", "do_steps", "rollbacks", "rejections", "iterations", "events")
 COLUMNS = [
     "master",
     "setting",
@@ -35,12 +36,7 @@ COLUMNS = [
     "trajectory_error",
     "event_time_error",
     "energy_residual",
-    "steps",
-    "do_steps",
-    "rollbacks",
-    "rejections",
-    "iterations",
-    "events",
+    *COUNTERS,
 ]
 
 
@@ -65,7 +61,7 @@ class Row:
             "trajectory_error": self.accuracy.get("trajectory_error", math.nan),
             "event_time_error": self.accuracy.get("event_time_error", math.nan),
             "energy_residual": energy,
-            **{k: stats.get(k, 0) for k in COLUMNS[9:]},
+            **{k: stats.get(k, 0) for k in COUNTERS},
         }
 
 

@@ -40,13 +40,3 @@ def test_elastic_impacts_stay_energy_consistent(rows) -> None:
     row = rows["m739_elastic_impacts"]
     assert row.status == "completed"
     assert row.energy_residual < 1e-3
-
-
-def test_jammed_mechanism_says_why(tmp_path, fmu_cache) -> None:
-    from orchestrator.run import run_scene
-    from orchestrator.scenario import load_scene
-
-    scene = load_scene(next(f for f in case_files() if f.stem == "m739_jam"))
-    result = run_scene(scene, output_dir=tmp_path, cache_dir=fmu_cache, show_progress=False)
-    assert result.value("armed") == 0.0
-    assert "held by friction" in result.headline["not_armed_reason"]["value"]

@@ -187,8 +187,7 @@ class RegimeAwareMaster:
             if target is not None:
                 h = min(h, target - t + 0.5 * cfg.event_tolerance)
             state = system.get_state()
-            self.refresh()
-            before = self.snapshot()
+            before = self.snapshot()  # consistent: every trial and settle ends refreshed
             try:
                 h, te = self._attempt(t, h, before, state)
                 if te is not None:
