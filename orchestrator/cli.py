@@ -57,6 +57,14 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--dask", metavar="ADDRESS", help="run the sweep on this Dask scheduler")
     p.set_defaults(handler=_precision)
 
+    p = sub.add_parser("sweep", help="run a scene's [sweep]: one run per value, CSV/PNG/table")
+    p.add_argument("scene", type=Path)
+    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
+    p.add_argument("--output", type=Path, help="directory (default runs/<scene>/sweep)")
+    p.add_argument("--workers", type=int, help="local processes (default: one per core)")
+    p.add_argument("--dask", metavar="ADDRESS", help="run the sweep on this Dask scheduler")
+    p.set_defaults(handler=_sweep)
+
     p = sub.add_parser("stability", help="run the stability suite (scenarios/stability/)")
     p.add_argument("--output", type=Path, default=Path("runs") / "stability")
     p.add_argument("--workers", type=int, help="local processes (default: one per core)")
@@ -177,6 +185,17 @@ def _precision(args: argparse.Namespace) -> int:
     out = Path(rows[0].result.job.output_dir).parent if rows else args.output
     print(f"report in {out}/work_precision.md (.csv, .png)")
     return 0
+
+
+def _sweep(args: argparse.Namespace) -> int:
+    from orchestrator.parameter_sweep import run_sweep
+
+    result = run_sweep(
+        args.scene, args.output, args.workers, args.dask, _overrides(args.set) or None
+    )
+    print((result.output_dir / "sweep.md").read_text())
+    print(f"results in {result.output_dir} (sweep.csv, sweep.png, sweep.md)")
+    return 0 if all(r["status"] == "completed" for r in result.rows) else 1
 
 
 def _stability(args: argparse.Namespace) -> int:

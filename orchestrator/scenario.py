@@ -75,6 +75,25 @@ class StopCondition:
 
 
 @dataclass(frozen=True)
+class SweepSeries:
+    label: str
+    overrides: dict[str, Any]  # dotted keys, as with --set
+
+
+@dataclass(frozen=True)
+class SweepSpec:
+    """One run per (series, value): the scene with ``parameter`` set to each value."""
+
+    parameter: str  # dotted key, e.g. "fmus.verge.parameters.center_distance"
+    values: tuple[Any, ...]  # as written (a unit string or a number)
+    si_values: tuple[float, ...]  # the same in SI, for tables and plots
+    unit: str  # SI unit of the swept value ("1" when plain)
+    label: str
+    quantities: tuple[str, ...]  # headline quantities tabulated and plotted; () = all
+    series: tuple[SweepSeries, ...]
+
+
+@dataclass(frozen=True)
 class Scene:
     path: Path
     name: str
@@ -93,6 +112,7 @@ class Scene:
     reference: str | None = None
     stop_when: StopCondition | None = None
     error_bound: float = math.inf  # the error against the reference the scene claims
+    sweep: SweepSpec | None = None  # run by ``mechcosim sweep``; ``run`` ignores it
 
     def component_class(self, instance: str) -> type[Component]:
         return component_class(self.fmus[instance].fmu)
@@ -166,7 +186,9 @@ class _Loader:
     # -- sections ---------------------------------------------------------------------
     def scene(self) -> Scene:
         raw = self.table(self.raw, "")
-        self.check_keys(raw, "", {"scene", "fmus", "connections", "master", "output", "report"})
+        self.check_keys(
+            raw, "", {"scene", "fmus", "connections", "master", "output", "report", "sweep"}
+        )
         for section in ("scene", "fmus", "master"):
             if section not in raw:
                 raise self.fail(section, "missing section")
@@ -188,6 +210,7 @@ class _Loader:
         )
         report = self.table(raw.get("report", {}), "report")
         headline, analysis, options, reference, error_bound = self.report(report, fmus)
+        sweep = self.sweep(raw["sweep"], fmus) if "sweep" in raw else None
         return Scene(
             path=self.path,
             name=name,
@@ -206,6 +229,7 @@ class _Loader:
             reference=reference,
             stop_when=stop_when,
             error_bound=error_bound,
+            sweep=sweep,
         )
 
     def stop_when(self, node: Any, fmus: dict[str, FmuSpec]) -> StopCondition:
@@ -426,3 +450,64 @@ class _Loader:
         if isinstance(bound, bool) or not isinstance(bound, int | float) or not bound > 0:
             raise self.fail("report.error_bound", f"expected a positive number, got {bound!r}")
         return headline, analysis, dict(options), reference, float(bound)
+
+    def sweep(self, node: Any, fmus: dict[str, FmuSpec]) -> SweepSpec:
+        node = self.table(node, "sweep")
+        self.check_keys(node, "sweep", {"parameter", "values", "label", "quantities", "series"})
+        parameter = self.string(node, "parameter", "sweep.parameter")
+        unit = self.swept_unit(parameter, fmus)
+        values = node.get("values")
+        if not isinstance(values, list) or not values:
+            raise self.fail("sweep.values", "expected a non-empty array of values")
+        si = tuple(
+            self.quantity(v, f"sweep.values[{k}]", unit) if unit else self.number(v, k)
+            for k, v in enumerate(values)
+        )
+        quantities = node.get("quantities", [])
+        if not isinstance(quantities, list) or not all(isinstance(q, str) for q in quantities):
+            raise self.fail("sweep.quantities", "expected an array of headline quantity names")
+        series = []
+        entries = node.get("series", [])
+        if not isinstance(entries, list):
+            raise self.fail("sweep.series", "expected an array of tables [[sweep.series]]")
+        for k, entry in enumerate(entries):
+            key = f"sweep.series[{k}]"
+            entry = self.table(entry, key)
+            self.check_keys(entry, key, {"label", "set"})
+            label = self.string(entry, "label", f"{key}.label")
+            overrides = self.table(entry.get("set", {}), f"{key}.set")
+            for dotted in overrides:
+                self.swept_unit(dotted, fmus, f"{key}.set.{dotted}")
+            series.append(SweepSeries(label, dict(overrides)))
+        label = self.string(node, "label", "sweep.label", default=parameter)
+        return SweepSpec(
+            parameter, tuple(values), si, unit or "1", label, tuple(quantities), tuple(series)
+        )
+
+    def swept_unit(self, dotted: str, fmus: dict[str, FmuSpec], key: str = "sweep.parameter"):
+        """SI unit of a key a sweep may set (None: a plain value); fails on unknown keys."""
+        parts = dotted.split(".")
+        if len(parts) == 4 and parts[0] == "fmus" and parts[2] in ("parameters", "inputs"):
+            instance, kind, name = parts[1], parts[2], parts[3]
+            if instance not in fmus:
+                raise self.fail(key, f"unknown FMU instance {instance!r} in {dotted!r}")
+            cls = component_class(fmus[instance].fmu)
+            causality = "parameter" if kind == "parameters" else "input"
+            names = [v.name for v in cls.VARIABLES if v.causality == causality]
+            if name not in names:
+                raise self.fail(key, f"{fmus[instance].fmu} has no {causality} {name!r}")
+            return cls.variable(name).unit
+        if len(parts) == 2 and parts[0] == "master" and parts[1] in _MASTER_KEYS:
+            return _MASTER_KEYS[parts[1]][0]
+        if len(parts) == 2 and parts[0] == "scene" and parts[1] in ("start", "stop"):
+            return "s"
+        raise self.fail(
+            key,
+            f"cannot sweep {dotted!r}; expected fmus.<instance>.parameters.<name>, "
+            "fmus.<instance>.inputs.<name>, master.<setting> or scene.start/stop",
+        )
+
+    def number(self, value: Any, k: int) -> float:
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            raise self.fail(f"sweep.values[{k}]", f"expected a number, got {value!r}")
+        return float(value)
