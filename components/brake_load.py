@@ -59,6 +59,8 @@ class BrakeLoad(Component):
     the scene, so it is not ``external_work``.
     """
 
+    REGIME_NAMES = REGIME_NAMES
+
     PORTS = {"shaft": {"angle": "angle", "speed": "speed", "torque": "torque"}}
 
     VARIABLES = (

@@ -201,6 +201,8 @@ class CrankCouplerDrive(Component):
     ``input_work`` is the same number under its older name.
     """
 
+    REGIME_NAMES = REGIME_NAMES
+
     PORTS = {"rocker": {"angle": "angle", "speed": "speed", "torque": "torque"}}
 
     VARIABLES = (

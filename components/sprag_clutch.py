@@ -233,6 +233,8 @@ class SpragClutch(Component):
     and give the transmitted torque, which loads the rocker and drives the roller.
     """
 
+    REGIME_NAMES = REGIME_NAMES
+
     PORTS = {
         "outer": {"angle": "angle_outer", "speed": "speed_outer", "torque": "torque"},
         "inner": {"angle": "angle_inner", "speed": "speed_inner", "torque": "torque"},

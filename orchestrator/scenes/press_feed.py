@@ -261,7 +261,7 @@ def analyse(
     cycle_of = np.floor(t / fs.period + 1e-12).astype(int)
     sel = np.isin(cycle_of, list(normal)) & (col[f"{fs.load}.regime"] == REGIME_SLIP_FORWARD)
     if sel.any():
-        out["mean_windup_feed"] = _q(np.mean(windup[sel]), "rad")
+        out["mean_windup_feed"] = _q(time_mean(t, windup, sel), "rad")
     if not fs.rigid:
         for name, signal, unit in (
             ("peak_deflection", "q", "m"),
@@ -283,6 +283,19 @@ def analyse(
             np.diff(np.interp([0, n * fs.period], t, col[ext]))[0] / n, "J"
         )
     return out
+
+
+def time_mean(t: np.ndarray, x: np.ndarray, sel: np.ndarray) -> float:
+    """Time average of x over the intervals whose two ends are selected (trapezoids).
+
+    The regime-aware master samples densely near switches; a plain mean of the samples
+    would weight those instants far more than the rest.
+    """
+    both = sel[:-1] & sel[1:]
+    dt = np.diff(t)[both]
+    if dt.sum() <= 0.0:
+        return float(np.mean(x[sel]))
+    return float(np.sum(0.5 * (x[:-1] + x[1:])[both] * dt) / dt.sum())
 
 
 def run_regime_sequences(scene: Scene, header: list[str], data: np.ndarray) -> list[list[int]]:
