@@ -55,6 +55,16 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--output", type=Path, help="directory (default runs/<scene>_work_precision)")
     p.add_argument("--workers", type=int, help="local processes (default: one per core)")
     p.add_argument("--dask", metavar="ADDRESS", help="run the sweep on this Dask scheduler")
+    p.add_argument(
+        "--tolerances",
+        type=_floats,
+        help="tolerances of the tolerance-driven masters, comma-separated (default 1e-2,...,1e-4)",
+    )
+    p.add_argument(
+        "--step-factors",
+        type=_floats,
+        help="fixed-step macro steps as multiples of the scene's (default 8,...,0.25)",
+    )
     p.set_defaults(handler=_precision)
 
     p = sub.add_parser("sweep", help="run a scene's [sweep]: one run per value, CSV/PNG/table")
@@ -98,6 +108,18 @@ def _overrides(pairs: list[str]) -> dict[str, object]:
         except tomllib.TOMLDecodeError:  # ... or a bare string such as 0.5 ms
             out[key] = text
     return out
+
+
+def _floats(text: str) -> tuple[float, ...]:
+    try:
+        values = tuple(float(v) for v in text.split(","))
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"expected comma-separated numbers, got {text!r}"
+        ) from None
+    if not values or min(values) <= 0.0:
+        raise argparse.ArgumentTypeError(f"expected positive numbers, got {text!r}")
+    return values
 
 
 def _run(args: argparse.Namespace) -> int:
@@ -177,9 +199,21 @@ def _crosscheck(args: argparse.Namespace) -> int:
 
 
 def _precision(args: argparse.Namespace) -> int:
-    from orchestrator.work_precision import observed_order, work_precision
+    from orchestrator.work_precision import (
+        STEP_FACTORS,
+        TOLERANCES,
+        observed_order,
+        work_precision,
+    )
 
-    rows = work_precision(args.scene, args.output, workers=args.workers, dask_address=args.dask)
+    rows = work_precision(
+        args.scene,
+        args.output,
+        step_factors=args.step_factors or STEP_FACTORS,
+        tolerances=args.tolerances or TOLERANCES,
+        workers=args.workers,
+        dask_address=args.dask,
+    )
     for master in dict.fromkeys(r.master for r in rows):
         print(f"  {master:14s} observed order {observed_order(rows, master):.2f}")
     out = Path(rows[0].result.job.output_dir).parent if rows else args.output
