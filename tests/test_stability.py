@@ -10,6 +10,10 @@ EXPECTED_STABLE = {
     "m739_friction_zero",
     "m739_jam",
     "m739_spin_x4",
+    "press_feed_brake_below_min",
+    "press_feed_brake_near_min",
+    "press_feed_coupler_x100",
+    "press_feed_hertz_clutch",
     "two_inertias_huge_step",
 }
 

@@ -63,6 +63,7 @@ from components.press_feed_data import (
     N_DAMP,
     ROLLER_RADIUS,
     RUNS,
+    BentCoupler,
     RSSRLinkage,
 )
 from components.rssr_coupler import (
@@ -106,6 +107,7 @@ class FeedOptions:
     brake_torque: float | None = None
     j5: float | None = None
     linkage: RSSRLinkage | None = None
+    bent_coupler: BentCoupler | None = None  # None: the run's coupler
     event_kinematics: str = "fourier"  # linearized model: "exact" | "fourier" rocker for events
     rtol: float = 1e-10
     atol: float = 1e-14
@@ -136,6 +138,9 @@ def feed_regime(brake: int, engaged: bool, rocker_forward: bool) -> int:
 # -- the assembled nonlinear model ----------------------------------------------------------
 class _Nonlinear:
     """Drive + clutch + brake with their own laws; discrete state = (brake, engaged, lock)."""
+
+    # The subsystem each event function of ``events`` belongs to, in order.
+    EVENT_SOURCES = ("clutch", "brake", "rocker")
 
     def __init__(
         self,
@@ -367,8 +372,9 @@ def _setup(o: FeedOptions):
         return mach, y0, rpm
     j5 = o.j5 if o.j5 is not None else J_O5_SHAFT + run.j_strip
     lk = o.linkage or LINKAGE_TABLE1
-    drive = build_drive_model(rpm, lk, run.coupler, rigid=o.coupler == "rigid")
-    phi1_0 = rocker_extremes(ExactRSSR(lk, run.coupler.alpha))[1]
+    coupler = o.bent_coupler or run.coupler
+    drive = build_drive_model(rpm, lk, coupler, rigid=o.coupler == "rigid")
+    phi1_0 = rocker_extremes(ExactRSSR(lk, coupler.alpha))[1]
     k = K_SP
     if o.clutch == "hertz":
         # Part III: geometric stiffness; the sprags' share of A1 (119) rides on the inner race.
@@ -413,6 +419,7 @@ def _integrate(mach, y0: np.ndarray, t_end: float, o: FeedOptions, grid: np.ndar
         if sol.status == 1:
             which = next(i for i, te in enumerate(sol.t_events) if len(te))
             before = mach.regime()
+            brake_before = getattr(mach, "brake", None)
             left = y.copy()
             w_left = mach.observe(t, y)[0]
             mach.handle(which, t, y)
@@ -424,6 +431,9 @@ def _integrate(mach, y0: np.ndarray, t_end: float, o: FeedOptions, grid: np.ndar
                     "y": left,
                     "y_right": y.copy(),
                     "windup": w_left,
+                    # which subsystem switched (None: the thesis's one-event machine)
+                    "source": getattr(mach, "EVENT_SOURCES", (None,) * (which + 1))[which],
+                    "brake_before": brake_before,
                 }
             )
             after = mach.regime()
@@ -452,7 +462,7 @@ def simulate_feed(o: FeedOptions = FeedOptions()) -> FeedResult:
     res = FeedResult(regime_log=log, events=events, period=period, phi1_0=mach.phi1_0)
 
     # Signals on the sample grid (the machine's discrete state is replayed from the log).
-    gauge, at_b = strain_factors(RUNS[o.run].coupler)
+    gauge, at_b = strain_factors(o.bent_coupler or RUNS[o.run].coupler)
     w_series, trq_series = sw[:, 0], sw[:, 1]
     res.series = {
         "t": st,

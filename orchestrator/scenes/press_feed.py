@@ -29,14 +29,13 @@ from components.press_feed_data import (
     K_SP,
     N_DAMP,
     RPM,
-    RUNS,
     BentCoupler,
     RSSRLinkage,
 )
 from components.rssr_coupler import REGIME_FORWARD, CrankCouplerDrive, build_drive_model
 from components.rssr_coupler import REGIME_NAMES as DRIVE_NAMES
 from components.rssr_kinematics import ExactRSSR, rocker_extremes
-from components.sprag_clutch import MODEL_LUMPED, REGIME_ENGAGED, SpragClutch
+from components.sprag_clutch import MODEL_HERTZ, MODEL_LUMPED, REGIME_ENGAGED, SpragClutch
 from components.sprag_clutch import REGIME_NAMES as CLUTCH_NAMES
 from orchestrator.references import Reference
 from orchestrator.references.press_feed import peak_to_trough_ratios
@@ -388,17 +387,23 @@ def feed_options(scene: Scene):
 
     need(pd["start_at_max"] > 0.5, "the drive must start at the rocker extreme")
     run = 1
+    coupler = None
     if not fs.rigid:
         coupler = fs.coupler()
         run = 3 if coupler.lumped_mass > 0.0 else 1
-        ref = RUNS[run].coupler
-        need(
-            all(_same(getattr(coupler, f), getattr(ref, f)) for f in ref.__dataclass_fields__),
-            "the coupler must be the standard one or the Run 3 one (9.1 lb at B)",
-        )
+        # Any bent coupler of the standard shape (Runs 1-3, or a stiffer/denser tube).
         for name in ("j_o4", "f1_a0", "f1_a1", "f1_b1", "f2_const"):
             need(_same(pd[name], defaults[name]), f"drive parameter {name} must keep its default")
-    need(pc["model"] == MODEL_LUMPED and _same(pc["k"], K_SP), "clutch: lumped K = 2e5 lbf*in")
+    clutch_defaults = {v.name: float(v.start) for v in SpragClutch.variables("parameter")}
+    if pc["model"] == MODEL_HERTZ:
+        geometry = ("r_outer", "r_inner", "r_sprag", "sprag_offset", "n_sprags", "strut_inner",
+                    "strut_outer", "youngs", "poisson")  # fmt: skip
+        need(
+            all(_same(pc[g], clutch_defaults[g]) for g in geometry),
+            "clutch: the two-point Hertz model needs the Table 4 sprag geometry",
+        )
+    else:
+        need(pc["model"] == MODEL_LUMPED and _same(pc["k"], K_SP), "clutch: lumped K = 2e5 lbf*in")
     need(pc["engaged0"] > 0.5 and _same(pc["n_damp"], N_DAMP), "clutch: engaged0 = 1, n = 1/4")
     if pc["c_lin"] == 0.0 and _same(pc["c_nl"], C_NL):
         damping = "nonlinear"
@@ -412,6 +417,8 @@ def feed_options(scene: Scene):
         run=run,
         damping=damping,
         coupler="rigid" if fs.rigid else "elastic",
+        clutch="hertz" if pc["model"] == MODEL_HERTZ else "lumped",
+        bent_coupler=coupler,
         cycles=max(1, math.ceil(duration / fs.period - 1e-9)),
         rpm=fs.omega / RPM,
         brake_torque=pl["brake_torque"],
@@ -436,6 +443,12 @@ def _subsystem_events(res, fs: FeedScene, duration: float) -> list[tuple[float, 
         t, a, b = ev["t"], ev["regime"], ev["after"]
         if t > duration:
             break
+        if ev.get("source") == "brake" and ev["brake_before"] != REGIME_STICK:
+            # The roller stops; while the clutch overruns this changes no thesis regime.
+            out.append((t, fs.load, slip, stick))
+            if a == FEED:
+                forward = b == WINDUP
+            continue
         if a == OVERRUN and b != OVERRUN:
             out.append((t, fs.clutch, overrun, engaged))
             if not forward:
