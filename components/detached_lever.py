@@ -41,7 +41,6 @@ import math
 from typing import Any
 
 import numpy as np
-from scipy.optimize import brentq, least_squares
 
 from components.base import COMMON_OUTPUTS, Component, ComponentError, Variable
 from components.detached_lever_data import (
@@ -61,6 +60,7 @@ FREE = 0
 UNLOCK = 1
 IMPULSE = 2
 STOPPED = 3
+REGIME_NAMES = {FREE: "free", UNLOCK: "unlock", IMPULSE: "impulse", STOPPED: "stopped"}
 
 _HALF_PI = 0.5 * math.pi
 _TWO_PI = 2.0 * math.pi
@@ -103,6 +103,8 @@ class DetachedLever(Component):
     beat_count, amplitude and period follow the true extremes (speed zeros) in both modes;
     cycle_end_angle is the thesis's amplitude, theta sampled at psi = 2 pi (mode 0).
     """
+
+    REGIME_NAMES = REGIME_NAMES
 
     VARIABLES = (
         Variable("inertia", "parameter", "kg.m2", _I0, "balance polar inertia I"),
@@ -554,6 +556,8 @@ def steady_state(
     (map above the diagonal below it, below above it; Coulomb sticking makes the map jump), then
     refined by bracketing.  (nan, nan) when the escapement does not sustain motion.
     """
+    from scipy.optimize import brentq  # not at module level: the FMU packs numpy only
+
     eps = max(params.get("epsilon", _WE.epsilon), params.get("sigma", _WE.epsilon))
 
     def gap(a: float) -> float:
@@ -615,6 +619,8 @@ def table_i_angle_switched_fit(unit: int, inertia: float = BALANCE_INERTIA) -> t
     least squares on the three steady amplitudes (C, omega0 and the angles are the unit's own).
     The period is then a prediction of the angle-switched model.
     """
+    from scipy.optimize import least_squares  # not at module level: the FMU packs numpy only
+
     u = TABLE_I[unit]
     params = table_i_params(unit, inertia)
     targets = np.array(table_i_phase_steady(unit))
