@@ -32,6 +32,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import brentq
 
+from components.clock_train import ClockMesh as TrainClockMesh
 from components.mesh_efficiency_data import INCH, ClockMesh, InvoluteMesh
 
 #: The programs' truncated pi and degree factor (note §4); only for regression to the printout.
@@ -401,3 +402,234 @@ def clock_sweep(
     model = ClockMeshModel(mesh)
     res = [model.cycle(mu, n)[2:] for mu in mus]
     return np.array([r[0] for r in res]), np.array([r[1] for r in res])
+
+
+# ------------------------------------------------------------------------------------------
+# A cycle at constant load torque: contact phases, input work, extremes
+# ------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class CycleSummary:
+    """One mesh cycle driven at a set speed against a constant load torque.
+
+    work_efficiency: output work / input work.  The driver torque is load * ratio / eps, so
+        this is the ratio-weighted harmonic mean of the point efficiency, not the report's
+        CYCLEFF (the arithmetic mean of K points, which holds for a constant driver torque).
+    mean_efficiency: the driver-angle mean of the point efficiency (CYCLEFF as K -> infinity).
+    minimum, maximum: the extremes over the cycle, one-sided limits at the phase changes
+        included (the report's minimum is that of its K points).
+    mean_ratio: driven rotation per driver rotation over the cycle.
+    """
+
+    work_efficiency: float
+    mean_efficiency: float
+    minimum: float
+    maximum: float
+    mean_ratio: float
+
+
+def involute_phase_breaks(geom: InvoluteGeometry) -> tuple[float, float, float]:
+    """Driver angles [rad] in [alpha_in, alpha_in + cycle) where the contact phase changes:
+    (a new pair enters, end of dual contact, a pair crosses the pitch point)."""
+    a0, c = geom.alpha_in, geom.cycle_angle
+    if not a0 < geom.alpha_fin < a0 + c:
+        raise ValueError("end of dual contact outside the cycle: contact ratio not in (1, 2)")
+    return a0, geom.alpha_fin, a0 + (math.tan(geom.op_pressure_angle) - a0) % c
+
+
+def involute_linear_terms(
+    geom: InvoluteGeometry, mu: float, alpha1: float
+) -> tuple[float, float, float, float]:
+    """(n0, n1, d0, d1): the point efficiency is (n0 + n1 a) / (d0 + d1 a) for every driver
+    roll angle a [rad] of the contact phase of alpha1 (same pairs, same approach/recess signs).
+
+    Eqs. 46/47 and A-26 are linear in a1 = r_drv a and a2 = a1 + p_b within a phase, which makes
+    the cycle integrals closed-form.
+    """
+    r1, r2 = geom.driver_base_radius, geom.driven_base_radius
+    rho1, rho2 = geom.driver_pivot_radius, geom.driven_pivot_radius
+    tan_op, d, pb = math.tan(geom.op_pressure_angle), geom.d, geom.base_pitch
+    s1 = _signum(alpha1, tan_op)
+    if alpha1 <= geom.alpha_fin:
+        s2 = _signum(alpha1 + pb / r1, tan_op)
+        s = s1 + s2
+        q = math.sqrt(4.0 + mu * mu * (4.0 + s * s) + mu**4 * s * s) / (1.0 + mu * mu)
+        return (
+            2.0 - mu * (s * d - s2 * pb + rho2 * q) / r2,
+            mu * s * r1 / r2,
+            2.0 + mu * (rho1 * q - s2 * pb) / r1,
+            -mu * s,
+        )
+    return 1.0 - mu * (rho2 + s1 * d) / r2, mu * s1 * r1 / r2, 1.0 + mu * rho1 / r1, -mu * s1
+
+
+def _integral_linear_ratio(p0: float, p1: float, q0: float, q1: float, a: float, b: float) -> float:
+    """Integral of (p0 + p1 x) / (q0 + q1 x) over [a, b], the denominator keeping its sign."""
+    qa = q0 + q1 * a
+    if q1 == 0.0:
+        return (p0 * (b - a) + 0.5 * p1 * (b * b - a * a)) / q0
+    k = p1 / q1  # numerator = k * denominator + (p0 - k q0)
+    return k * (b - a) + (p0 - k * q0) * math.log1p(q1 * (b - a) / qa) / q1
+
+
+def involute_cycle_summary(geom: InvoluteGeometry, mu: float) -> CycleSummary:
+    """Closed-form CycleSummary of an involute mesh (constant speed ratio r_drv / r_dvn)."""
+    breaks = sorted(involute_phase_breaks(geom))
+    ends = [*breaks, geom.alpha_in + geom.cycle_angle]
+    inv_eff = mean = 0.0
+    values = []
+    for a, b in zip(ends[:-1], ends[1:], strict=True):
+        if b <= a:
+            continue
+        n0, n1, d0, d1 = involute_linear_terms(geom, mu, 0.5 * (a + b))
+        if min(n0 + n1 * a, n0 + n1 * b) <= 0.0:
+            raise ValueError(f"point efficiency reaches zero with mu = {mu}: the mesh locks")
+        inv_eff += _integral_linear_ratio(d0, d1, n0, n1, a, b)
+        mean += _integral_linear_ratio(n0, n1, d0, d1, a, b)
+        values += [(n0 + n1 * a) / (d0 + d1 * a), (n0 + n1 * b) / (d0 + d1 * b)]
+    c = geom.cycle_angle
+    ratio = geom.driver_base_radius / geom.driven_base_radius
+    return CycleSummary(c / inv_eff, mean / c, min(values), max(values), ratio)
+
+
+# ------------------------------------------------------------------------------------------
+# The derived clock efficiency on the two-pass train kinematics (components.clock_train)
+# ------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class TrainMeshContact:
+    """Contact of a clock_train mesh at one gear angle, in the mesh-1 convention of that
+    module (gear pivot at the origin turning counter-clockwise, pinion pivot at b e^(i beta1))."""
+
+    phase: str  # "ror" round-on-round (four-bar), "rof" gear round on the radial pinion flank
+    local_angle: float  # rad, gear angle moved into the pair window [handover - pitch, handover)
+    pinion_angle: float  # rad, pinion angle with every earlier pair counted (continuous)
+    ratio: float  # d pinion / d gear (negative: external mesh)
+    pinion_pivot: np.ndarray  # m
+    contact: np.ndarray  # m
+    normal: np.ndarray  # unit normal of the force on the pinion
+
+
+def train_mesh_window(mesh: TrainClockMesh) -> tuple[float, float]:
+    """(start, length) of a tooth pair's window of gear angles, mesh-1 convention [rad]: the
+    pair takes over at handover - pitch and hands over at handover."""
+    pitch = 2.0 * math.pi / mesh.n_gear
+    return mesh.handover() - pitch, pitch
+
+
+def _train_pair_contact(mesh: TrainClockMesh, local: float, phase: str) -> TrainMeshContact:
+    """Contact of the pair at gear angle ``local`` of its window, phase given (no reduction)."""
+    s = -1.0 if mesh.mirrored else 1.0
+    x = s * mesh.driven_angle(s * local, phase)  # pinion angle, mesh-1 convention
+    ratio = mesh.speed_ratio(s * local, phase)
+    o_p = mesh.b * _unit(mesh.beta1)
+    c_g = mesh.a_g * _unit(local - mesh.delta_g)
+    if phase == "ror":  # the normal joins the two centres of curvature
+        normal = o_p + mesh.a_p * _unit(x - mesh.delta_p) - c_g
+        normal /= math.hypot(normal[0], normal[1])
+    else:  # square to the radial flank, through the gear round's centre
+        e = _unit(x + mesh.alpha_p)
+        m = np.array([-e[1], e[0]])
+        normal = -math.copysign(1.0, float(m @ (c_g - o_p))) * m
+    return TrainMeshContact(phase, local, x, ratio, o_p, c_g + mesh.rho_g * normal, normal)
+
+
+def train_mesh_contact(mesh: TrainClockMesh, phi1: float) -> TrainMeshContact:
+    """Contact at gear angle phi1 [rad] (mesh-1 convention), any tooth pair."""
+    start, pitch = train_mesh_window(mesh)
+    k = math.floor((phi1 - start) / pitch)
+    local = phi1 - k * pitch
+    phase = "ror" if local < mesh.transition()[0] else "rof"
+    c = _train_pair_contact(mesh, local, phase)
+    lead = 2.0 * math.pi / mesh.n_pinion
+    return TrainMeshContact(
+        phase, local, c.pinion_angle - k * lead, c.ratio, c.pinion_pivot, c.contact, c.normal
+    )
+
+
+def train_contact_efficiency(c: TrainMeshContact, mu: float, rho_g: float, rho_p: float) -> float:
+    """Point efficiency of a train_mesh_contact result (pivot radii rho_g, rho_p [m])."""
+    return contact_efficiency(np.zeros(2), c.pinion_pivot, c.contact, c.normal, mu, rho_g, rho_p)[0]
+
+
+def train_mesh_efficiency(
+    mesh: TrainClockMesh, mu: float, phi1: float, rho_gear: float, rho_pinion: float
+) -> tuple[float, float]:
+    """(point efficiency, speed ratio d pinion / d gear) at gear angle phi1 (mesh-1 convention).
+
+    The derived model of note §2.5 (the same statics as ClockMeshModel) on the kinematics of
+    components.clock_train: round-on-round, the normal through both round centres; round-on-
+    flank, through the gear round's centre square to the radial flank.  rho_*: pivot radii [m].
+    """
+    c = train_mesh_contact(mesh, phi1)
+    return train_contact_efficiency(c, mu, rho_gear, rho_pinion), c.ratio
+
+
+def _train_sliding(mesh: TrainClockMesh, local: float, phase: str) -> float:
+    """Sliding speed of the gear over the pinion along the common tangent, per unit gear speed."""
+    c = _train_pair_contact(mesh, local, phase)
+    r1, r2 = c.contact, c.contact - c.pinion_pivot
+    v = np.array([-r1[1], r1[0]]) - c.ratio * np.array([-r2[1], r2[0]])
+    return _cross(c.normal, v)
+
+
+def train_mesh_breaks(mesh: TrainClockMesh) -> tuple[tuple[float, str], ...]:
+    """Gear angles [rad] (mesh-1 convention) of one window where the contact phase changes,
+    sorted, with their kind: "pair" (a new pair takes over: the window start), "contact"
+    (round-on-round -> round-on-flank) and "pitch" (the sliding reverses: the contact crosses
+    the line of centres, approach -> recess)."""
+    start, pitch = train_mesh_window(mesh)
+    transition = mesh.transition()[0]
+    breaks = [(start, "pair")]
+    parts = [(start, start + pitch, "ror")]
+    if start < transition < start + pitch:
+        breaks.append((transition, "contact"))
+        parts = [(start, transition, "ror"), (transition, start + pitch, "rof")]
+    for a, b, phase in parts:
+        grid = np.linspace(a, b, 65)
+        values = [_train_sliding(mesh, float(x), phase) for x in grid]
+        for k in range(64):
+            if values[k] == 0.0 or values[k] * values[k + 1] < 0.0:
+                root = brentq(
+                    lambda x, ph=phase: _train_sliding(mesh, x, ph),
+                    float(grid[k]), float(grid[k + 1]), xtol=1e-15, rtol=1e-15,
+                )  # fmt: skip
+                if a < root < b:
+                    breaks.append((root, "pitch"))
+    return tuple(sorted(breaks))
+
+
+def train_mesh_cycle_summary(
+    mesh: TrainClockMesh, mu: float, rho_gear: float, rho_pinion: float
+) -> CycleSummary:
+    """CycleSummary of a clock_train mesh over one pair window (adaptive quadrature per phase).
+
+    The extremes are taken on a dense grid and 1e-9 of the window inside each phase change (the
+    efficiency jumps there; at the reversal itself the sliding friction is undefined).
+    """
+    from scipy.integrate import quad
+
+    start, pitch = train_mesh_window(mesh)
+    breaks = [b for b, _ in train_mesh_breaks(mesh)]
+    ends = [*breaks, start + pitch]
+    transition = mesh.transition()[0]
+    inv_eff = mean = 0.0
+    values = []
+    for a, b in zip(ends[:-1], ends[1:], strict=True):
+        phase = "ror" if 0.5 * (a + b) < transition else "rof"
+
+        def eff(x: float, phase: str = phase) -> float:
+            return train_contact_efficiency(
+                _train_pair_contact(mesh, x, phase), mu, rho_gear, rho_pinion
+            )
+
+        def ratio(x: float, phase: str = phase) -> float:
+            return -mesh.speed_ratio((-1.0 if mesh.mirrored else 1.0) * x, phase)
+
+        kw = {"epsabs": 0.0, "epsrel": 1e-13, "limit": 200}
+        inv_eff += quad(lambda x: ratio(x) / eff(x), a, b, **kw)[0]
+        mean += quad(eff, a, b, **kw)[0]
+        eps = 1e-9 * pitch
+        values += [eff(float(x)) for x in np.linspace(a + eps, b - eps, 201)]
+    if min(values) <= 0.0:
+        raise ValueError(f"point efficiency reaches zero with mu = {mu}: the mesh locks")
+    turned = 2.0 * math.pi / mesh.n_pinion  # one leaf per gear pitch
+    return CycleSummary(turned / inv_eff, mean / pitch, min(values), max(values), turned / pitch)

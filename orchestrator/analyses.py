@@ -41,6 +41,8 @@ def energy_residual(header: list[str], data: np.ndarray) -> dict[str, Any] | Non
     Needs every FMU's stored_energy and dissipated_work recorded (and external_work where a
     component has it); returns None when they are not.
     """
+    if len(data) == 0:  # nothing recorded (e.g. an FMU failed to initialize)
+        return None
     instances = {h.split(".")[0] for h in header[1:]}
     total = np.zeros(len(data))
     scale = 0.0
@@ -70,6 +72,9 @@ ANALYSES = LazyRegistry(
     {
         "m739": "orchestrator.scenes.m739:analyse",
         "press_feed": "orchestrator.scenes.press_feed:analyse",
+        "detached_lever": "orchestrator.scenes.detached_lever:analyse",
+        "gear_mesh": "orchestrator.scenes.gear_mesh:analyse",
+        "clock_train": "orchestrator.scenes.clock_train:analyse",
     }
 )
 #: Scene plots, drawn after a completed run when the scene names the analysis:
@@ -78,5 +83,8 @@ PLOTS = LazyRegistry(
     {
         "m739": "orchestrator.scenes.m739:plot",
         "press_feed": "orchestrator.scenes.press_feed:plot",
+        "detached_lever": "orchestrator.scenes.detached_lever:plot",
+        "gear_mesh": "orchestrator.scenes.gear_mesh:plot",
+        "clock_train": "orchestrator.scenes.clock_train:plot",
     }
 )

@@ -69,6 +69,7 @@ class FmuInstance:
         )
         self.fmu.instantiate(callbacks=self._callbacks, loggingOn=True)
         self._alive = True
+        self._freeable = True
 
     def _log(self, env: Any, instance: bytes, status: int, category: bytes, message: bytes) -> None:
         self.messages.append(message.decode("utf-8", "replace") if message else "")
@@ -96,6 +97,9 @@ class FmuInstance:
                     self.fmu.setReal(self.refs([name]), [value])
             self.fmu.exitInitializationMode()
         except FMICallException as exc:
+            # pythonfmu's runtime crashes on terminating or freeing an instance whose
+            # initialization raised: leave it allocated (a small leak, once per failed run).
+            self._alive = self._freeable = False
             raise RunError(
                 f"initialization failed: {self.last_message() or exc}", start, self.name
             ) from None
@@ -147,5 +151,6 @@ class FmuInstance:
             pass
         # Free the instance but keep the shared library loaded: pythonfmu's runtime embeds
         # the interpreter and does not survive being unloaded and loaded again in a process.
-        self.fmu.fmi2FreeInstance(self.fmu.component)
+        if self._freeable:
+            self.fmu.fmi2FreeInstance(self.fmu.component)
         self.fmu = None

@@ -30,5 +30,8 @@ REFERENCES = LazyRegistry(
         "two_inertias": "orchestrator.references.two_inertias:two_inertias_reference",
         "m739": "orchestrator.scenes.m739:reference",
         "press_feed": "orchestrator.scenes.press_feed:reference",
+        "detached_lever": "orchestrator.scenes.detached_lever:reference",
+        "gear_mesh": "orchestrator.scenes.gear_mesh:reference",
+        "clock_train": "orchestrator.scenes.clock_train:reference",
     }
 )
