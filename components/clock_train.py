@@ -274,6 +274,86 @@ class ClockMesh:
         """d^2(input)/d(output)^2 [1/rad], the report's X Z (note §6.0)."""
         return self._inverse(phi_out, phase)[2]
 
+    # -- smooth pieces, for dynamics with the output (pinion) angle as the coordinate ----------
+    # A piece is one tooth pair k in one phase; on it the kinematics is analytic.  In the local
+    # pinion angle x = s phi_out - k q (mesh-1 convention, q the pinion pitch) the pair's window
+    # is (end, end + q]: RoR on (x_T, end + q], RoF on (end, x_T]; the gear turning forward
+    # moves x down.  A dynamic model freezes the piece inside an integrator stage and moves to
+    # the next one at a located crossing of its bounds (note §10 item 1: RoR -> RoF -> handover).
+    @property
+    def window_end(self) -> float:
+        """Local pinion angle x (mesh-1 convention) at which the pair hands over."""
+        if "window_end" not in self._cache:
+            self._cache["window_end"] = self._pair_forward(self.handover(), "rof")[0]
+        return self._cache["window_end"]
+
+    @property
+    def pinion_pitch(self) -> float:
+        return _TWO_PI / self.n_pinion
+
+    @property
+    def gear_pitch(self) -> float:
+        return _TWO_PI / self.n_gear
+
+    @property
+    def sign(self) -> float:
+        """Own convention = sign * mesh-1 convention (-1 for the mirrored mesh)."""
+        return -1.0 if self.mirrored else 1.0
+
+    def inverse_piece(self, phi_out: float, direction: int = 1) -> tuple[int, str]:
+        """(k, phase) of the piece holding the output angle phi_out [rad, own convention].
+
+        direction +1: the gear turns forward (x falling), -1 backward; on a bound, the piece
+        being entered is returned (windows (end, end + q] forward, [end, end + q) backward).
+        """
+        q, end, xt = self.pinion_pitch, self.window_end, self.transition()[1]
+        y = self.sign * phi_out
+        if direction >= 0:
+            k = math.ceil((y - end) / q) - 1
+            x = y - k * q
+            return k, ("ror" if x > xt else "rof")
+        k = math.floor((y - end) / q)
+        x = y - k * q
+        return k, ("ror" if x >= xt else "rof")
+
+    def piece_bounds(self, phase: str) -> tuple[float, float]:
+        """(lower, upper) local pinion angle x of a phase's piece (mesh-1 convention)."""
+        end, xt = self.window_end, self.transition()[1]
+        return (xt, end + self.pinion_pitch) if phase == "ror" else (end, xt)
+
+    def local_output(self, phi_out: float, k: int) -> float:
+        """Local pinion angle x (mesh-1 convention) of pair k."""
+        return self.sign * phi_out - k * self.pinion_pitch
+
+    def inverse_on_piece(self, phi_out: float, k: int, phase: str) -> tuple[float, float, float]:
+        """Inverse kinematics on a given piece (continued analytically past its bounds):
+        (driver angle, d driver/d output, d^2 driver/d output^2), own convention."""
+        s = self.sign
+        v, der, second = self._pair_inverse(s * phi_out - k * self.pinion_pitch, phase)
+        return s * (v - k * self.gear_pitch), der, s * second
+
+    def contact(self, x: float, v: float, phase: str) -> tuple[float, float, float, float]:
+        """Contact point (cx, cy) and unit normal (nx, ny) of the force on the pinion.
+
+        Mesh-1 convention, gear pivot at the origin, pinion pivot at b (cos beta1, sin beta1);
+        x, v are the local pinion and gear angles of the pair (``_pair_inverse``).  RoR: the
+        normal joins the two round centres; RoF: it is square to the radial flank, from the
+        gear round's centre towards the flank.
+        """
+        cgx = self.a_g * math.cos(v - self.delta_g)
+        cgy = self.a_g * math.sin(v - self.delta_g)
+        opx, opy = self.b * math.cos(self.beta1), self.b * math.sin(self.beta1)
+        if phase == "ror":
+            nx = opx + self.a_p * math.cos(x - self.delta_p) - cgx
+            ny = opy + self.a_p * math.sin(x - self.delta_p) - cgy
+            r = math.hypot(nx, ny)
+            nx, ny = nx / r, ny / r
+        else:
+            ex, ey = math.cos(x + self.alpha_p), math.sin(x + self.alpha_p)
+            side = ex * (cgy - opy) - ey * (cgx - opx)  # C_G's side of the flank line
+            nx, ny = (ey, -ex) if side >= 0.0 else (-ey, ex)
+        return cgx + self.rho_g * nx, cgy + self.rho_g * ny, nx, ny
+
     def _forward(self, phi_in: float, phase: str) -> tuple[float, float, float]:
         s = -1.0 if self.mirrored else 1.0
         phi1 = s * phi_in

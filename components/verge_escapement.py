@@ -35,6 +35,13 @@ Per-tooth bookkeeping (§3.2): phi_local = phi_T + phi_off; entrance -> exit add
 phi_local, 2 pi - lambda to psi and lambda to psic; exit -> entrance subtracts (NT + 1) Delta,
 2 pi - lambda and lambda.  The output ``psi`` is the verge angle in entrance-face
 coordinates (psi + psic - psic0, wrapped), so it is continuous across re-indexing.
+
+The escapement centre distance a = |O_p O_s| is the parameter ``center_distance`` (default the
+M739's 0.226 in): it enters the face kinematics and contact sensing and the fuze-body angles of
+the pallet pivot (``escapement_data``), the parts themselves unchanged, as in the selective
+assembly of the test plans (note models/clock_train_kinematics.md §2.2).  ``J_load`` = I_p U^2
+is the verge inertia riding on the wheel while coupled (0 when free), for a train whose own
+impacts (clock-train tooth handover) must include it.
 """
 
 from __future__ import annotations
@@ -76,6 +83,43 @@ IND_STOP = 7
 
 def _sgn(x: float) -> int:
     return -1 if x < 0.0 else 1
+
+
+def escapement_data(center_distance: float, phi_local_start: float = M739.phi_start) -> M739Data:
+    """The M739 data with the escapement centre distance a = |O_p O_s| set [m].
+
+    a is the one length of the loop C10 (App C) that is not a part dimension: the face
+    kinematics (C17, C15), the contact sensing (E4, E5), and the fuze-body angles of the
+    pallet pivot (B7, B12: O_p stays at R_4 from the spin axis, so delta_4, gamma_4', beta_3
+    and gamma_p' follow a) all take it from here; the default reproduces the M739 exactly.
+    """
+    d = M739
+    a = float(center_distance)
+    if not abs(d.r3 - d.r4) < a < d.r3 + d.r4:
+        raise ComponentError(
+            f"VergeEscapement: center_distance {a:.6g} m outside ({abs(d.r3 - d.r4):.6g}, "
+            f"{d.r3 + d.r4:.6g}) m: the pallet pivot cannot sit at R4 from the spin axis"
+        )
+    if not abs(d.b - d.c) < a < d.b + d.c:
+        raise ComponentError(
+            f"VergeEscapement: center_distance {a:.6g} m outside ({abs(d.b - d.c):.6g}, "
+            f"{d.b + d.c:.6g}) m: the tooth-tip circle (b) never meets the pallet corners (c), "
+            "so no tooth could leave a face"
+        )
+    # The start configuration must have the tooth tip on the entrance face (C17 solvable, g > 0).
+    alpha = d.alpha_en
+    cap_a = a * math.cos(alpha) + d.b * math.cos(phi_local_start - alpha)
+    cap_b = a * math.sin(alpha) - d.b * math.sin(phi_local_start - alpha)
+    cap_c = d.c * math.sin(alpha)
+    if (
+        cap_a * cap_a + cap_b * cap_b < cap_c * cap_c
+        or kinem(phi_local_start, alpha, a, d.b, d.c)[1] <= 0.0
+    ):
+        raise ComponentError(
+            f"VergeEscapement: center_distance {a:.6g} m leaves the escape-wheel tooth off the "
+            f"entrance face at phi_local_start = {phi_local_start:.6g} rad"
+        )
+    return d if a == d.a else d.with_(a=a)
 
 
 class VergeConstants:
@@ -660,6 +704,13 @@ class VergeEscapement(Component):
             "closing speed below which contact is gentle (no impact)",
         ),
         Variable("h_max", "parameter", "s", 1.0e-6, "largest internal RK4 step"),
+        Variable(
+            "center_distance",
+            "parameter",
+            "m",
+            M739.a,
+            "escapement centre distance O_p-O_s (pallet pivot to escape-wheel pivot)",
+        ),
         Variable("phi", "input", "rad", 0.0, "cumulative escape-wheel angle", sampled=True),
         Variable("phi_dot", "input", "rad/s", 0.0, "escape-wheel speed", sampled=True),
         Variable("J_ref", "input", "kg.m2", 2.8e-9, "train effective inertia at the wheel"),
@@ -689,6 +740,9 @@ class VergeEscapement(Component):
             -1.0,
             "first regime change or impact of the last step that had one",
         ),
+        Variable(
+            "J_load", "output", "kg.m2", 0.0, "verge inertia at the wheel, I_p U^2 (0 when free)"
+        ),
         Variable("external_work", "output", "J", 0.0, "work of the spin on the pallet"),
         *COMMON_OUTPUTS,
     )
@@ -696,7 +750,8 @@ class VergeEscapement(Component):
     def initialize(self, t0: float) -> None:
         if self.h_max <= 0.0:
             raise ComponentError("VergeEscapement: h_max must be positive")
-        k = VergeConstants(M739, self.mu1, self.mu, self.spin, self.e_rest)
+        data = escapement_data(self.center_distance, self.phi_local_start)
+        k = VergeConstants(data, self.mu1, self.mu, self.spin, self.e_rest)
         self._held = HeldTrain(self.J_ref, self.T_ref, self.c_load, self.J_stot)
         self._core = VergeCore(
             k, self._held, self.phi_local_start - self.phi, v_capture=self.v_capture
@@ -792,14 +847,15 @@ class VergeEscapement(Component):
         core = self._core
         k = core.k
         if core.coupled:
-            acc, psi, psi_d, _, pn, t_esc, g, *_ = core.coupled_terms(y)
+            acc, psi, psi_d, _, pn, t_esc, g, u, *_ = core.coupled_terms(y)
             self.PN, self.T_esc, self.ind_pn = pn, t_esc, pn
+            self.J_load = k.ip * u * u
             self.ind_face_end = core.face * g
             self.ind_gap = 0.0
         else:
             acc = core.free_terms(y)[0]
             psi, psi_d = y[2], y[3]
-            self.PN = self.T_esc = self.ind_pn = 0.0
+            self.PN = self.T_esc = self.ind_pn = self.J_load = 0.0
             ind = core.indicators(y)
             self.ind_face_end, self.ind_gap = ind[IND_FACE_END], ind[IND_CONTACT]
         self.v_close = core.closing_speed(y)[0]

@@ -39,5 +39,10 @@ FMU_WRAPPERS: dict[str, FmuWrapper] = {
         ),
         _wrapper("SpragClutch", "sprag_clutch_fmu", "components.sprag_clutch.SpragClutch"),
         _wrapper("BrakeLoad", "brake_load_fmu", "components.brake_load.BrakeLoad"),
+        _wrapper("DetachedLever", "detached_lever_fmu", "components.detached_lever.DetachedLever"),
+        _wrapper("GearMesh", "gear_mesh_fmu", "components.gear_mesh.GearMesh"),
+        _wrapper(
+            "ClockGearTrain", "clock_gear_train_fmu", "components.clock_gear_train.ClockGearTrain"
+        ),
     )
 }

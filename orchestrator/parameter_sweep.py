@@ -145,7 +145,7 @@ def _plot(result: SweepResult, path: Path) -> None:
         ax.set_ylabel(f"{q} [{result.units.get(q) or '1'}]")
         ax.grid(True, alpha=0.3)
         if any(r["series"] for r in result.rows):
-            ax.legend(fontsize="small")
+            ax.legend(fontsize="x-small", ncol=2)
     axes[-1, 0].set_xlabel(f"{spec.label} [{spec.unit}]")
     fig.suptitle(f"{result.scene.name}: sweep of {spec.label}")
     fig.tight_layout()
