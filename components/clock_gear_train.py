@@ -69,9 +69,9 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from components.base import COMMON_OUTPUTS, Component, ComponentError, Variable
+from components.base import COMMON_OUTPUTS, ComponentError, Variable
 from components.clock_train import M739_TRAIN, ClockMesh, ClockTrain
-from components.gear_train import advance
+from components.gear_train import TrainComponent
 from components.m739_data import M739, M739Data
 
 LOSS_NONE = 0
@@ -430,7 +430,7 @@ class _ClockModel:
         self.t_esc = t_esc
         self.j_load = j_load
         self.stuck = False
-        self.t_switch = -1.0  # first internal event inside the current step
+        self.t_first_event = -1.0  # first internal event inside the current step
 
     def accel(self, phi: float, phi_dot: float) -> float:
         j, t, c = self.p.response(phi, phi_dot)
@@ -465,8 +465,8 @@ class _ClockModel:
             self.p.update_i1r(y[1], self.accel(y[0], y[1]))
 
     def event(self, y: list[float], index: int, t: float) -> list[float]:
-        if self.t_switch < 0.0:
-            self.t_switch = t
+        if self.t_first_event < 0.0:
+            self.t_first_event = t
         if index < 4:
             w, loss = self.p.cross(y[0], y[1], self.j_load)
             return [y[0], w, y[2] + loss]
@@ -499,7 +499,7 @@ class _ClockModel:
         self.stuck = True
 
 
-class ClockGearTrain(Component):
+class ClockGearTrain(TrainComponent):
     """M739 rotor behind the two-pass clock train, 1 DOF (cumulative escape-wheel angle).
 
     Regime codes: 0 stuck (static friction), 1..4 the mesh phases (mesh 1 / mesh 2):
@@ -513,6 +513,8 @@ class ClockGearTrain(Component):
     """
 
     REGIME_NAMES = REGIME_NAMES
+    _PHYSICS = ClockTrainPhysics
+    _MODEL = _ClockModel
     PORTS = {
         "escape_wheel": {
             "angle": "phi",
@@ -610,42 +612,9 @@ class ClockGearTrain(Component):
             self._model.try_unstick(self.phi_start)
         self._outputs()
 
-    def _apply_inputs(self) -> None:
-        """Take a new impact speed (once per impact_count change) and the held load.
-
-        Idempotent, so it may run in update_outputs and again at the step start.
-        """
-        m, p = self._model, self._phys
-        m.t_esc = self.T_esc
-        m.j_load = self.J_load
-        y = self._y
-        if int(self.impact_count) != self._seen_impacts:
-            self._seen_impacts = int(self.impact_count)
-            y = self._y = [y[0], self.phi_dot_impact, y[2]]
-            if y[1] != 0.0:
-                p.set_direction(1 if y[1] > 0.0 else -1, y[0])
-                m.stuck = False
-        if y[1] == 0.0:
-            m.try_unstick(y[0])
-        elif p.direction * y[1] < 0.0:
-            p.set_direction(1 if y[1] > 0.0 else -1, y[0])
-
-    def update_outputs(self) -> None:
-        # Direct feedthrough: forces and phi_ddot depend on T_esc; an impact sets phi_dot.
-        self._apply_inputs()
-        self._outputs()
-
-    def step(self, t: float, h: float) -> None:
-        self._apply_inputs()
-        m = self._model
-        m.t_switch = -1.0
-        if m.stuck and self._y[1] == 0.0:
-            self._outputs()  # held at rest by static friction under held inputs
-            return
-        self._y, _, _, _ = advance(m, self._y, h, self.h_max)
-        if m.t_switch >= 0.0:
-            self.t_event = t + m.t_switch
-        self._outputs()
+    def _take_loads(self) -> None:
+        self._model.t_esc = self.T_esc
+        self._model.j_load = self.J_load
 
     def _outputs(self) -> None:
         p, m = self._phys, self._model
@@ -677,25 +646,3 @@ class ClockGearTrain(Component):
         self.stored_energy = 0.5 * j0 * w * w
         self.external_work = p.a35 * (math.cos(rotor) - self._cos0)
         self.dissipated_work = wd
-
-    # The snapshot copies the mutable mode and state; the constants (train geometry, memo
-    # tuples) are immutable in use and shared, which keeps it cheap.
-    def get_state(self) -> dict[str, Any]:
-        snap = dict(self.__dict__)
-        if "_phys" in snap:
-            snap["_y"] = list(self._y)
-            snap["_phys"] = dict(self._phys.__dict__)
-            snap["_model"] = {n: v for n, v in self._model.__dict__.items() if n != "p"}
-        return snap
-
-    def set_state(self, state: dict[str, Any]) -> None:
-        self.__dict__.clear()
-        self.__dict__.update(state)
-        if "_phys" in state:
-            self._y = list(state["_y"])
-            phys = ClockTrainPhysics.__new__(ClockTrainPhysics)
-            phys.__dict__.update(state["_phys"])
-            model = _ClockModel.__new__(_ClockModel)
-            model.__dict__.update(state["_model"])
-            model.p = phys
-            self._phys, self._model = phys, model

@@ -462,7 +462,7 @@ class _TrainModel:
         self.p = phys
         self.t_esc = t_esc
         self.stuck = False
-        self.t_speed_event = -1.0  # first reversal / stick inside the current step
+        self.t_first_event = -1.0  # first reversal / stick inside the current step
 
     def accel(self, phi: float, phi_dot: float) -> float:
         j, t, c = self.p.response(phi, phi_dot)
@@ -492,8 +492,8 @@ class _TrainModel:
         if index < 2:
             p.on_mesh_event(y[0])
             return y
-        if self.t_speed_event < 0.0:
-            self.t_speed_event = t
+        if self.t_first_event < 0.0:
+            self.t_first_event = t
         return self.reverse_or_stick(y)
 
     def reverse_or_stick(self, y: list[float]) -> list[float]:
@@ -525,7 +525,81 @@ class _TrainModel:
         self.stuck = True
 
 
-class GearTrain(Component):
+class TrainComponent(Component):
+    """What every spin-driven train FMU shares: taking impacts and the held escapement load,
+    stepping the 1-DOF model with event location, and cheap state snapshots.
+
+    A subclass names its physics and model classes and provides ``initialize`` and
+    ``_outputs``; ``self._phys``, ``self._model`` and ``self._y`` hold the state.
+    """
+
+    _PHYSICS: type
+    _MODEL: type
+
+    def _take_loads(self) -> None:
+        """Copy the held inputs the model integrates with."""
+        self._model.t_esc = self.T_esc
+
+    def _apply_inputs(self) -> None:
+        """Take a new impact speed (once per impact_count change) and the held load.
+
+        Idempotent, so it may run in update_outputs and again at the step start.
+        """
+        self._take_loads()
+        m, y = self._model, self._y
+        if int(self.impact_count) != self._seen_impacts:
+            self._seen_impacts = int(self.impact_count)
+            y = self._y = [y[0], self.phi_dot_impact, y[2]]
+            if y[1] != 0.0:
+                m.p.set_direction(1 if y[1] > 0.0 else -1, y[0])
+                m.stuck = False
+        if y[1] == 0.0:
+            m.try_unstick(y[0])
+        elif m.p.direction * y[1] < 0.0:
+            m.p.set_direction(1 if y[1] > 0.0 else -1, y[0])
+
+    def update_outputs(self) -> None:
+        # Direct feedthrough: F12, F23, phi_ddot depend on T_esc; an impact sets phi_dot.
+        self._apply_inputs()
+        self._outputs()
+
+    def step(self, t: float, h: float) -> None:
+        self._apply_inputs()
+        m = self._model
+        m.t_first_event = -1.0
+        if m.stuck and self._y[1] == 0.0:
+            # Held at rest by static friction under held inputs: nothing moves in this step.
+            self._outputs()
+            return
+        self._y, _, _, _ = advance(m, self._y, h, self.h_max)
+        if m.t_first_event >= 0.0:
+            self.t_event = t + m.t_first_event
+        self._outputs()
+
+    # The snapshot copies the mutable mode and state; the constants (and the memo of
+    # mode-only coefficients) are immutable in use and shared, which keeps it cheap.
+    def get_state(self) -> dict[str, Any]:
+        snap = dict(self.__dict__)
+        if "_phys" in snap:
+            snap["_y"] = list(self._y)
+            snap["_phys"] = dict(self._phys.__dict__)
+            snap["_model"] = {n: v for n, v in self._model.__dict__.items() if n != "p"}
+        return snap
+
+    def set_state(self, state: dict[str, Any]) -> None:
+        self.__dict__.clear()
+        self.__dict__.update(state)
+        if "_phys" in state:
+            self._y = list(state["_y"])
+            phys = self._PHYSICS.__new__(self._PHYSICS)
+            phys.__dict__.update(state["_phys"])
+            model = self._MODEL.__new__(self._MODEL)
+            model.__dict__.update(state["_model"])
+            model.p = phys
+            self._phys, self._model = phys, model
+
+
+class GearTrain(TrainComponent):
     """M739 train, 1 DOF (cumulative escape-wheel angle), escapement torque as input.
 
     Regime codes: 0 stuck (static friction), 1 moving forward, 2 moving backward.
@@ -539,6 +613,8 @@ class GearTrain(Component):
     """
 
     REGIME_NAMES = TRAIN_REGIME_NAMES
+    _PHYSICS = TrainPhysics
+    _MODEL = _TrainModel
     PORTS = {
         "escape_wheel": {
             "angle": "phi",
@@ -607,43 +683,6 @@ class GearTrain(Component):
             self._model.try_unstick(self.phi_start)
         self._outputs()
 
-    def _apply_inputs(self) -> None:
-        """Take a new impact speed (once per impact_count change) and the held load.
-
-        Idempotent, so it may run in update_outputs and again at the step start.
-        """
-        m = self._model
-        m.t_esc = self.T_esc
-        y = self._y
-        if int(self.impact_count) != self._seen_impacts:
-            self._seen_impacts = int(self.impact_count)
-            y = self._y = [y[0], self.phi_dot_impact, y[2]]
-            if y[1] != 0.0:
-                self._phys.set_direction(1 if y[1] > 0.0 else -1, y[0])
-                m.stuck = False
-        if y[1] == 0.0:
-            m.try_unstick(y[0])
-        elif self._phys.direction * y[1] < 0.0:
-            self._phys.set_direction(1 if y[1] > 0.0 else -1, y[0])
-
-    def update_outputs(self) -> None:
-        # Direct feedthrough: F12, F23, phi_ddot depend on T_esc; an impact sets phi_dot.
-        self._apply_inputs()
-        self._outputs()
-
-    def step(self, t: float, h: float) -> None:
-        self._apply_inputs()
-        m = self._model
-        m.t_speed_event = -1.0
-        if m.stuck and self._y[1] == 0.0:
-            # Held at rest by static friction under held inputs: nothing moves in this step.
-            self._outputs()
-            return
-        self._y, _, _, _ = advance(m, self._y, h, self.h_max)
-        if m.t_speed_event >= 0.0:
-            self.t_event = t + m.t_speed_event
-        self._outputs()
-
     def _outputs(self) -> None:
         p, m = self._phys, self._model
         phi, w, wd = self._y
@@ -668,25 +707,3 @@ class GearTrain(Component):
         # Work of the spin (centrifugal moment on the eccentric rotor) since the start.
         self.external_work = p.a35 * (math.cos(M739.phi1c + p.n31 * phi) - self._cos0)
         self.dissipated_work = wd
-
-    # The snapshot copies the mutable mode and state; the constants (and the memo of
-    # mode-only coefficients) are immutable in use and shared, which keeps it cheap.
-    def get_state(self) -> dict[str, Any]:
-        snap = dict(self.__dict__)
-        if "_phys" in snap:
-            snap["_y"] = list(self._y)
-            snap["_phys"] = dict(self._phys.__dict__)
-            snap["_model"] = {n: v for n, v in self._model.__dict__.items() if n != "p"}
-        return snap
-
-    def set_state(self, state: dict[str, Any]) -> None:
-        self.__dict__.clear()
-        self.__dict__.update(state)
-        if "_phys" in state:
-            self._y = list(state["_y"])
-            phys = TrainPhysics.__new__(TrainPhysics)
-            phys.__dict__.update(state["_phys"])
-            model = _TrainModel.__new__(_TrainModel)
-            model.__dict__.update(state["_model"])
-            model.p = phys
-            self._phys, self._model = phys, model

@@ -135,8 +135,24 @@ def run_m739(
     train = TrainPhysics(data, mu=mu, omega=omega, indexing=code)
     k = VergeConstants(data, mu1, mu, omega, e_rest)
     core = _Monolithic(k, train, data.phi_start, phi_stop=data.phi_cut, log=log)
+    return simulate(core, data, events, t_stop, h_max, sample_dt)
+
+
+def simulate(
+    core: _Monolithic,
+    data: M739Data,
+    events: list[tuple[float, int, int, str]],
+    t_stop: float,
+    h_max: float,
+    sample_dt: float,
+    max_events: int = 2000,
+) -> M739Result:
+    """Run a monolithic verge-and-train model from rest until it halts or t_stop; never raises.
+
+    ``events`` is the list the core's log callback appends to.
+    """
     y = core._sync_kinematics([0.0, 0.0, 0.0, 0.0, 0.0])
-    if omega == 0.0:
+    if core.k.omega == 0.0:
         return _finish(core, y, 0.0, False, "no spin: no driving torque", events, {})
     core.s4 = core.s5 = 1  # V_S/T = 0 and psi_d = 0 at rest: +1 (§10.2 item 5)
     core.record(y)  # the report's t = 0 printout uses these signs
@@ -154,7 +170,8 @@ def run_m739(
         cols["psi_dot"].append(y[3])
         cols["regime"].append(core.regime)
         if core.coupled:
-            acc, pn = core.coupled_terms(y)[0], core.coupled_terms(y)[4]
+            terms = core.coupled_terms(y)
+            acc, pn = terms[0], terms[4]
         else:
             acc, pn = core.free_terms(y)[0], 0.0
         f12, f23 = core.train.forces(y[0], y[1], acc)
@@ -164,12 +181,11 @@ def run_m739(
 
     t = 0.0
     sample(t, y)
-    reason = "stop time reached"
     try:
         while t < t_stop and not core.train_stuck:
             h = min(sample_dt, t_stop - t)
             core.t_base = t
-            y, _, t_ev, _ = advance(core, y, h, h_max)
+            y, _, t_ev, _ = advance(core, y, h, h_max, max_events=max_events)
             if core.halted:
                 t += t_ev if t_ev >= 0.0 else h
                 sample(t, y)
@@ -180,6 +196,7 @@ def run_m739(
         return _finish(core, y, t, False, f"numerical failure: {exc}", events, cols)
     if core.halted and not core.train_stuck and not core.fault:
         return _finish(core, y, t, True, "armed", events, cols)
+    reason = "stop time reached"
     if core.train_stuck:
         reason = f"stall: {core.stall_reason}"
     elif core.fault:

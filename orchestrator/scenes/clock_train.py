@@ -24,21 +24,19 @@ import numpy as np
 
 from components.clock_gear_train import LOSS_POINT, ClockTrainPhysics
 from components.clock_train import M739_TRAIN
-from components.gear_train import advance
 from components.m739_data import LBF, M739, rpm_to_rad_s
 from components.verge_escapement import (
     FREE,
     IND_MESH_HI,
     IND_MESH_LO,
-    REGIME_NAMES,
     VergeConstants,
     escapement_data,
 )
 from components.verge_geometry import kinem
 from orchestrator.references import Reference
-from orchestrator.references.m739 import M739Result, _finish, _Monolithic
+from orchestrator.references.m739 import M739Result, _Monolithic, simulate
 from orchestrator.scenario import Scene
-from orchestrator.scenes.m739 import _names, _parameter, _q, _why_not_armed
+from orchestrator.scenes.m739 import _names, _parameter, _q, _why_not_armed, reference_from
 
 RPM_PER_RAD_S = 60.0 / (2.0 * math.pi)
 #: Rotor angle at arming: the M739's rotor travel, PHICUTD of escape wheel times N31 (= 1/32).
@@ -168,58 +166,7 @@ def run_clock_train(
     phi_stop = arming_phi(train, rotor_arming_angle)
     k = VergeConstants(data, mu1, mu, omega, e_rest)
     core = _ClockMonolithic(k, train, data.phi_start, phi_stop=phi_stop, log=log)
-    y = core._sync_kinematics([0.0, 0.0, 0.0, 0.0, 0.0])
-    if omega == 0.0:
-        return _finish(core, y, 0.0, False, "no spin: no driving torque", events, {})
-    core.s4 = core.s5 = 1
-    core.record(y)
-    y = core.decide_direction(y, 0.0, 1)
-
-    names = ("t", "phi", "phi_dot", "psi", "psi_dot", "regime", "f12", "f23", "pn")
-    cols: dict[str, list[float]] = {n: [] for n in names}
-
-    def sample(t: float, y: list[float]) -> None:
-        cols["t"].append(t)
-        cols["phi"].append(y[0])
-        cols["phi_dot"].append(y[1])
-        body = y[2] + core.psic - data.psic
-        cols["psi"].append(math.atan2(math.sin(body), math.cos(body)))
-        cols["psi_dot"].append(y[3])
-        cols["regime"].append(core.regime)
-        if core.coupled:
-            terms = core.coupled_terms(y)
-            acc, pn = terms[0], terms[4]
-        else:
-            acc, pn = core.free_terms(y)[0], 0.0
-        f12, f23 = train.forces(y[0], y[1], acc)
-        cols["f12"].append(f12)
-        cols["f23"].append(f23)
-        cols["pn"].append(pn)
-
-    t = 0.0
-    sample(t, y)
-    reason = "stop time reached"
-    try:
-        while t < t_stop and not core.train_stuck:
-            h = min(sample_dt, t_stop - t)
-            core.t_base = t
-            y, _, t_ev, _ = advance(core, y, h, h_max, max_events=20000)
-            if core.halted:
-                t += t_ev if t_ev >= 0.0 else h
-                sample(t, y)
-                break
-            t += h
-            sample(t, y)
-    except (ArithmeticError, ValueError, RuntimeError) as exc:
-        return _finish(core, y, t, False, f"numerical failure: {exc}", events, cols)
-    if core.halted and not core.train_stuck and not core.fault:
-        result = _finish(core, y, t, True, "armed", events, cols)
-    else:
-        if core.train_stuck:
-            reason = f"stall: {core.stall_reason}"
-        elif core.fault:
-            reason = core.fault
-        result = _finish(core, y, t, False, reason, events, cols)
+    result = simulate(core, data, events, t_stop, h_max, sample_dt, max_events=20000)
     result.handovers = train.handovers  # type: ignore[attr-defined]
     return result
 
@@ -245,29 +192,10 @@ def reference(scene: Scene) -> Reference:
         center_distance=_parameter(scene, verge, "center_distance"),
         rotor_arming_angle=level,
     )
-    s = result.series
-    headline = {
-        "F23_max": result.f23_max,
-        "F12_max": result.f12_max,
-        "FF23_max": result.ff23_max,
-        "FF12_max": result.ff12_max,
-        "PN_max": result.pn_max,
-        "impacts": float(result.impacts),
-    }
+    ref = reference_from(result, train, verge)
     if result.armed:
-        headline["turns_to_arm"] = result.turns
-        headline["arming_time"] = result.t_arm
-        headline["phi_at_arming"] = result.phi_end
-
-    def signals(times: np.ndarray) -> dict[str, np.ndarray]:
-        # The escape-wheel angle is continuous (speeds jump at impacts and handovers).
-        return {f"{train}.phi": np.interp(times, s["t"], s["phi"])}
-
-    events = [
-        (te, verge, REGIME_NAMES.get(a, str(a)), REGIME_NAMES.get(b, str(b)))
-        for te, a, b in result.regime_log
-    ]
-    return Reference(headline=headline, signals=signals, events=events)
+        ref.headline["phi_at_arming"] = result.phi_end
+    return ref
 
 
 def plot(scene: Scene, header: list[str], data: np.ndarray, path: Path) -> None:

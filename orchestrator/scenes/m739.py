@@ -99,6 +99,11 @@ def reference(scene: Scene) -> Reference:
         t_stop=scene.stop,
         indexing=int(_parameter(scene, train, "indexing")),
     )
+    return reference_from(result, train, verge)
+
+
+def reference_from(result: Any, train: str, verge: str) -> Reference:
+    """A Reference from a monolithic verge-and-train result (``M739Result``)."""
     s = result.series
     headline = {
         "F23_max": result.f23_max,
