@@ -85,8 +85,13 @@ def _sgn(x: float) -> int:
     return -1 if x < 0.0 else 1
 
 
-def escapement_data(center_distance: float, phi_local_start: float = M739.phi_start) -> M739Data:
-    """The M739 data with the escapement centre distance a = |O_p O_s| set [m].
+def escapement_data(
+    center_distance: float,
+    phi_local_start: float = M739.phi_start,
+    pallet_inertia: float = M739.ip,
+) -> M739Data:
+    """The M739 data with the escapement centre distance a = |O_p O_s| [m] and the pallet
+    inertia I_p [kg.m2] set (I_p scaled against the train gives the inertia-ratio cases).
 
     a is the one length of the loop C10 (App C) that is not a part dimension: the face
     kinematics (C17, C15), the contact sensing (E4, E5), and the fuze-body angles of the
@@ -119,7 +124,12 @@ def escapement_data(center_distance: float, phi_local_start: float = M739.phi_st
             f"VergeEscapement: center_distance {a:.6g} m leaves the escape-wheel tooth off the "
             f"entrance face at phi_local_start = {phi_local_start:.6g} rad"
         )
-    return d if a == d.a else d.with_(a=a)
+    if not pallet_inertia > 0.0:
+        raise ComponentError(
+            f"VergeEscapement: pallet_inertia {pallet_inertia:.6g} kg.m2 must be positive"
+        )
+    changes = {n: v for n, v, v0 in (("a", a, d.a), ("ip", pallet_inertia, d.ip)) if v != v0}
+    return d.with_(**changes) if changes else d
 
 
 class VergeConstants:
@@ -711,6 +721,13 @@ class VergeEscapement(Component):
             M739.a,
             "escapement centre distance O_p-O_s (pallet pivot to escape-wheel pivot)",
         ),
+        Variable(
+            "pallet_inertia",
+            "parameter",
+            "kg.m2",
+            M739.ip,
+            "verge (pallet) moment of inertia about its pivot, I_p",
+        ),
         Variable("phi", "input", "rad", 0.0, "cumulative escape-wheel angle", sampled=True),
         Variable("phi_dot", "input", "rad/s", 0.0, "escape-wheel speed", sampled=True),
         Variable("J_ref", "input", "kg.m2", 2.8e-9, "train effective inertia at the wheel"),
@@ -750,7 +767,7 @@ class VergeEscapement(Component):
     def initialize(self, t0: float) -> None:
         if self.h_max <= 0.0:
             raise ComponentError("VergeEscapement: h_max must be positive")
-        data = escapement_data(self.center_distance, self.phi_local_start)
+        data = escapement_data(self.center_distance, self.phi_local_start, self.pallet_inertia)
         k = VergeConstants(data, self.mu1, self.mu, self.spin, self.e_rest)
         self._held = HeldTrain(self.J_ref, self.T_ref, self.c_load, self.J_stot)
         self._core = VergeCore(

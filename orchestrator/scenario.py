@@ -33,7 +33,10 @@ _MASTER_KEYS: dict[str, tuple[str | None, bool]] = {
     "max_step": ("s", False),
     "max_iterations": (None, False),
     "max_events_per_step": (None, False),
+    "input_hold": ("choice", False),
 }
+# Master settings that take one of a few words.
+_MASTER_CHOICES: dict[str, tuple[str, ...]] = {"input_hold": ("start", "midpoint")}
 
 
 @dataclass(frozen=True)
@@ -377,7 +380,12 @@ class _Loader:
         for k, (unit, _) in _MASTER_KEYS.items():
             if k in ("algorithm", "step", "order") or k not in node:
                 continue
-            if unit is None:
+            if unit == "choice":
+                choices = list(_MASTER_CHOICES[k])
+                if node[k] not in choices:
+                    raise self.fail(f"master.{k}", f"expected one of {choices}, got {node[k]!r}")
+                options[k] = node[k]
+            elif unit is None:
                 if not isinstance(node[k], int) or isinstance(node[k], bool) or node[k] < 1:
                     raise self.fail(f"master.{k}", f"expected a positive integer, got {node[k]!r}")
                 options[k] = node[k]
@@ -498,6 +506,8 @@ class _Loader:
                 raise self.fail(key, f"{fmus[instance].fmu} has no {causality} {name!r}")
             return cls.variable(name).unit
         if len(parts) == 2 and parts[0] == "master" and parts[1] in _MASTER_KEYS:
+            if parts[1] in _MASTER_CHOICES:
+                raise self.fail(key, f"cannot sweep {dotted!r}: it is a word, not a number")
             return _MASTER_KEYS[parts[1]][0]
         if len(parts) == 2 and parts[0] == "scene" and parts[1] in ("start", "stop"):
             return "s"

@@ -7,9 +7,16 @@ be rolled back.  A trial step is accepted when
   named ``ind_*``) inside it — otherwise the switching instant is located (from the FMU's
   reported ``t_event`` when it has one, else by secant/bisection on the indicator) and the
   step is retaken to land on it within ``event_tolerance``; and
-* the coupling error estimate is within ``tolerance``: the inputs are held over the step,
-  so the error made is proportional to how much the exchanged signals change over it,
-  measured relative to each signal's running scale.
+* the coupling error estimate is within ``tolerance``.  With ``input_hold = "start"`` the
+  inputs are held at their step-start values, and the estimate is how much the exchanged
+  signals change over the step, relative to each signal's running scale (first order).
+  With ``input_hold = "midpoint"`` the step is taken twice: once with the step-start
+  inputs (predictor), then again from the saved state with each held input at the mean of
+  its start and predicted end values (corrector, second order).  The estimate is the
+  difference the correction makes to the exchanged outputs, i.e. the effect of the held
+  inputs on the receivers, not the size of their change: a small change of a large
+  torque that nearly cancels the receiver's drive is seen as the large effect it has.
+  Sampled inputs (a state taken at the step start) are never averaged.
 
 After a switch the master iterates the exchange at that instant to a fixed point (so an
 impact's momentum exchange reaches the other FMU before anything moves), records the left
@@ -37,6 +44,7 @@ class Settings:
     max_step: float
     max_iterations: int  # exchange rounds at a switching instant
     max_events_per_step: int  # switches allowed at (nearly) one instant before giving up
+    midpoint: bool  # corrector with held inputs at their step mean (else held at the start)
 
     @classmethod
     def of(cls, scene: Scene) -> Settings:
@@ -50,6 +58,7 @@ class Settings:
             max_step=o.get("max_step", min(100.0 * h, scene.stop - scene.start)),
             max_iterations=o.get("max_iterations", 10),
             max_events_per_step=o.get("max_events_per_step", 50),
+            midpoint=o.get("input_hold", "start") == "midpoint",
         )
 
 
@@ -79,6 +88,19 @@ class RegimeAwareMaster:
                 held.add(src)
         self.signals = sorted(held)
         self.scale = {s: 0.0 for s in self.signals}
+        # Midpoint hold: per instance, which of its Real inputs are held (averaged), and
+        # every Real connection source, whose predictor-corrector difference is the error.
+        self.held_inputs = [
+            [
+                (src, component_class(scene.fmus[name].fmu).variable(var).sampled)
+                for src, var in _real_inputs(system, scene, i)
+            ]
+            for i, name in enumerate(self.names)
+        ]
+        self.outputs = sorted({s for s in system.connection_sources if s is not None})
+        self.out_scale = {s: 0.0 for s in self.outputs}
+        self.ratio = 0.0  # error ratio of the last corrected trial
+        self.predicted: list[list[float]] = []  # end values the last corrected trial used
 
     # -- helpers ----------------------------------------------------------------------
     def snapshot(self) -> _Snapshot:
@@ -96,11 +118,49 @@ class RegimeAwareMaster:
         system = self.system
         for i in range(len(system.instances)):
             system.feed(i)
+        self._step_all(t, h)
+
+    def _step_all(self, t: float, h: float) -> None:
+        system = self.system
         for i in range(len(system.instances)):
             system.step(i, t, h)
         system.read_all()
         self.refresh()
         self.stats.do_steps += len(system.instances)
+
+    def corrected_trial(
+        self, t: float, h: float, before: _Snapshot, state: list[Any], predicted: list[list[float]]
+    ) -> None:
+        """Retake the step [t, t+h] from the saved state with every held input at the mean
+        of its start and ``predicted`` end values; ``self.ratio`` is the correction's size
+        against the tolerance (the predictor's error estimate)."""
+        system = self.system
+        system.set_state(state)  # the step-start outputs are read back as well
+        self.stats.rollbacks += 1
+        self.predicted = predicted  # to retake this very step (see _left_values)
+        start = before.values
+        for i, inputs in enumerate(self.held_inputs):
+            if not inputs:
+                continue
+            values = [
+                start[s][k] if sampled else 0.5 * (start[s][k] + predicted[s][k])
+                for (s, k), sampled in inputs
+            ]
+            system.instances[i].set_real(system.feeds[i].real_refs, values)
+            if system.feeds[i].int_refs:
+                ints = system.ints
+                system.instances[i].set_integer(
+                    system.feeds[i].int_refs, [ints[s][k] for s, k in system.feeds[i].int_sources]
+                )
+        self._step_all(t, h)
+        worst, tol = 0.0, self.cfg.tolerance
+        values = system.values
+        for i, k in self.outputs:
+            a, b = predicted[i][k], values[i][k]
+            scale = self.out_scale[(i, k)] = max(self.out_scale[(i, k)], abs(start[i][k]), abs(b))
+            if scale > 0.0:
+                worst = max(worst, abs(b - a) / (tol * scale))
+        self.ratio = worst
 
     def refresh(self) -> None:
         """Give every FMU the others' newest outputs, so that outputs which depend on
@@ -130,7 +190,11 @@ class RegimeAwareMaster:
                     best = te if best is None else min(best, te)
                     continue
                 if fired and te == t:
-                    continue  # switched at the step start, on inputs that crossed by t
+                    # Switched at the step start, on inputs that crossed by t: land on it
+                    # with a step of event_tolerance / 2, so that the exchange at the switch
+                    # (an impact's momentum) reaches the others before they move on.
+                    best = t if best is None else min(best, t)
+                    continue
             for g0, g1 in zip(before.indicators[i], after_ind[i], strict=True):
                 # A crossing leaves one strict sign; an indicator starting at zero (the
                 # switch it marks has just happened) does not switch again by leaving it.
@@ -191,16 +255,16 @@ class RegimeAwareMaster:
             try:
                 h, te = self._attempt(t, h, before, state)
                 if te is not None:
-                    left = self._left_values(t, te, h, state)
+                    left = self._left_values(t, te, h, state, before)
             finally:
                 system.free_state(state)
             t += h
             stats.steps += 1
             if te is None:
-                ratio = self.error_ratio(before)
+                ratio = self.ratio if cfg.midpoint else self.error_ratio(before)
                 stats.events += self.log_switches(t - h, before)  # switched at the start
                 recorder.row(system.record_row(t))
-                grow = 4.0 if ratio == 0.0 else min(4.0, max(0.2, 0.9 / ratio))
+                grow = 4.0 if ratio == 0.0 else min(4.0, max(0.2, self._factor(ratio)))
                 h = min(cfg.max_step, h * grow)
                 same_instant = 0
             else:
@@ -237,6 +301,11 @@ class RegimeAwareMaster:
         for _ in range(200):
             self.trial(t, h)
             te = self.switch_time(t, h, before)
+            if te is not None and cfg.midpoint:
+                te = self._correct_landing(t, h, te, before, state)
+            elif cfg.midpoint:
+                self.corrected_trial(t, h, before, state, [list(v) for v in self.system.values])
+                te = self.switch_time(t, h, before)
             if te is not None:
                 if t + h - te <= cfg.event_tolerance or h <= cfg.min_step:
                     return h, te  # the step ends on the switch
@@ -245,7 +314,7 @@ class RegimeAwareMaster:
                 self._rollback(state)
                 last_ratio = None
                 continue
-            ratio = self.error_ratio(before)
+            ratio = self.ratio if cfg.midpoint else self.error_ratio(before)
             if ratio > 1.0 and h > cfg.min_step:
                 # Two shrinks in a row that leave the change as large: a jump, not a smooth
                 # change (one shrink is not proof: a long step may span an oscillation).
@@ -254,22 +323,59 @@ class RegimeAwareMaster:
                     self.stats.extra["jumps"] = self.stats.extra.get("jumps", 0) + 1
                     return h, t + h  # land after the jump and treat it as a switch
                 last_ratio = ratio
-                h = max(cfg.min_step, h * max(0.2, 0.9 / ratio))
+                h = max(cfg.min_step, h * max(0.2, self._factor(ratio)))
                 self._rollback(state)
                 continue
             return h, None
         raise RunError(f"no acceptable step from here after 200 trials (last h = {h:.3e} s)", t)
 
-    def _left_values(self, t: float, te: float, h: float, state: list[Any]) -> list[float] | None:
+    def _correct_landing(
+        self, t: float, h: float, te: float, before: _Snapshot, state: list[Any]
+    ) -> float | None:
+        """The predictor saw a switch at te inside [t, t+h]: if the step does not yet end on
+        it, the caller shortens it (te is returned as is).  If it does, the step is corrected
+        with the end values predicted just before the switch (those after it would average a
+        jump into the held inputs), and the corrected step's own switch time is returned
+        (None if the correction moved the switch past the step end)."""
+        cfg = self.cfg
+        if t + h - te > cfg.event_tolerance and h > cfg.min_step:
+            return te
+        h_left = te - t - 0.5 * cfg.event_tolerance
+        if h_left > 0.0:
+            self.system.set_state(state)
+            self.stats.rollbacks += 1
+            self.trial(t, h_left)
+            predicted = [list(v) for v in self.system.values]
+        else:
+            predicted = before.values
+        self.corrected_trial(t, h, before, state, predicted)
+        return self.switch_time(t, h, before)
+
+    def _factor(self, ratio: float) -> float:
+        """Step factor for an error ratio: the held-start error estimate is first order in
+        h; the predictor's error (midpoint hold) is second order in h over a step."""
+        return 0.9 / ratio if not self.cfg.midpoint else (0.8 / ratio) ** 0.5
+
+    def _left_values(
+        self, t: float, te: float, h: float, state: list[Any], before: _Snapshot
+    ) -> list[float] | None:
         """Recorded values just before the switch at te (then the step is retaken to t+h)."""
         h_left = te - t - 0.5 * self.cfg.event_tolerance
         if h_left <= 0.0:
             return None
+        accepted = self.predicted
         self._rollback(state)
         self.trial(t, h_left)
+        if self.cfg.midpoint:
+            predicted = [list(v) for v in self.system.values]
+            self.corrected_trial(t, h_left, before, state, predicted)
         row = self.system.record_row(t + h_left)
-        self._rollback(state)
-        self.trial(t, h)
+        if self.cfg.midpoint:
+            # The very inputs of the accepted step: the retake must cross the switch again.
+            self.corrected_trial(t, h, before, state, accepted)
+        else:
+            self._rollback(state)
+            self.trial(t, h)
         return row
 
     def _rollback(self, state: list[Any]) -> None:
@@ -282,6 +388,16 @@ class RegimeAwareMaster:
             return "no FMU"
         t, sub, a, b = self.recorder.events[-1]
         return f"FMU {sub!r} ({a} -> {b})"
+
+
+def _real_inputs(system: CoupledSystem, scene: Scene, i: int) -> list[tuple[tuple[int, int], str]]:
+    """Instance i's Real inputs in feed order: (source slot, input variable name)."""
+    name = system.names[i]
+    out = []
+    for c, src in zip(scene.connections, system.connection_sources, strict=True):
+        if src is not None and c.target[0] == name:
+            out.append((src, c.target[1]))
+    return out
 
 
 def run_regime_aware(

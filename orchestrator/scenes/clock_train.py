@@ -138,6 +138,7 @@ def run_clock_train(
     pivot_loads: bool = True,
     mesh_phase: float = 0.0,
     center_distance: float = M739.a,
+    pallet_inertia: float = M739.ip,
     rotor_arming_angle: float = ARMING_ROTOR_ANGLE,
     h_max: float = 2.0e-6,
     sample_dt: float = 1.0e-5,
@@ -148,7 +149,7 @@ def run_clock_train(
     forces, impacts, regime log, series); it never raises.
     """
     omega = rpm_to_rad_s(rpm)
-    data = escapement_data(center_distance)
+    data = escapement_data(center_distance, pallet_inertia=pallet_inertia)
     events: list[tuple[float, int, int, str]] = []
 
     def log(t: float, old: int, new: int, why: str) -> None:
@@ -190,6 +191,7 @@ def reference(scene: Scene) -> Reference:
         pivot_loads=_parameter(scene, train, "pivot_loads") == 1.0,
         mesh_phase=_parameter(scene, train, "mesh_phase"),
         center_distance=_parameter(scene, verge, "center_distance"),
+        pallet_inertia=_parameter(scene, verge, "pallet_inertia"),
         rotor_arming_angle=level,
     )
     ref = reference_from(result, train, verge)

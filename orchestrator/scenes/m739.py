@@ -87,10 +87,15 @@ def _why_not_armed(scene: Scene, col: dict[str, np.ndarray], train: str) -> str:
 
 def reference(scene: Scene) -> Reference:
     """The monolithic M739 model with the scene's physics, as the yardstick."""
+    from components.verge_escapement import escapement_data
     from orchestrator.references.m739 import run_m739
 
     train, verge = _names(scene)
     spin = _parameter(scene, train, "spin")
+    data = escapement_data(
+        _parameter(scene, verge, "center_distance"),
+        pallet_inertia=_parameter(scene, verge, "pallet_inertia"),
+    )
     result = run_m739(
         mu=_parameter(scene, train, "mu"),
         mu1=_parameter(scene, verge, "mu1"),
@@ -98,6 +103,7 @@ def reference(scene: Scene) -> Reference:
         e_rest=_parameter(scene, verge, "e_rest"),
         t_stop=scene.stop,
         indexing=int(_parameter(scene, train, "indexing")),
+        data=data,
     )
     return reference_from(result, train, verge)
 
