@@ -71,7 +71,7 @@ from typing import Any
 
 from components.base import COMMON_OUTPUTS, ComponentError, Variable
 from components.clock_train import M739_TRAIN, ClockMesh, ClockTrain
-from components.gear_train import TrainComponent
+from components.gear_train import RestingTrainModel, TrainComponent
 from components.m739_data import M739, M739Data
 
 LOSS_NONE = 0
@@ -419,7 +419,7 @@ class ClockTrainPhysics:
 # ------------------------------------------------------------------------------------------
 # Component
 # ------------------------------------------------------------------------------------------
-class _ClockModel:
+class _ClockModel(RestingTrainModel):
     """The clock train with a held escapement torque, as an EventModel; y = [phi, phi_d, W].
 
     Indicators: piece bounds ahead (mesh 1, mesh 2), pitch points (mesh 1, mesh 2), speed.
@@ -471,32 +471,6 @@ class _ClockModel:
             w, loss = self.p.cross(y[0], y[1], self.j_load)
             return [y[0], w, y[2] + loss]
         return self.reverse_or_stick(y)
-
-    def reverse_or_stick(self, y: list[float]) -> list[float]:
-        """Speed crossed zero: reverse if the drive beats friction backwards, else stick."""
-        p = self.p
-        phi = y[0]
-        old = p.direction
-        p.set_direction(-old, phi)
-        if -old * self.accel(phi, 0.0) > 0.0:
-            return [phi, 0.0, y[2]]
-        p.set_direction(old, phi)
-        if old * self.accel(phi, 0.0) > 0.0:
-            return [phi, 0.0, y[2]]
-        self.stuck = True
-        return [phi, 0.0, y[2]]
-
-    def try_unstick(self, phi: float) -> None:
-        """At rest: start in whichever direction the net torque beats static friction."""
-        p = self.p
-        held = p.direction
-        for direction in (held, -held):
-            p.set_direction(direction, phi)
-            if direction * self.accel(phi, 0.0) > 0.0:
-                self.stuck = False
-                return
-        p.set_direction(held, phi)  # stuck: keep the direction (stable outputs)
-        self.stuck = True
 
 
 class ClockGearTrain(TrainComponent):

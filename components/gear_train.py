@@ -455,7 +455,52 @@ class TrainPhysics:
 # ---------------------------------------------------------------------------------------
 # Component
 # ---------------------------------------------------------------------------------------
-class _TrainModel:
+class RestingTrainModel:
+    """Reversal, start and stick at zero wheel speed, for a train model with ``p`` (the
+    physics: direction, set_direction, update_i1r), ``accel(phi, phi_dot)`` and ``stuck``."""
+
+    p: Any
+    stuck: bool
+
+    def accel(self, phi: float, phi_dot: float) -> float:
+        raise NotImplementedError
+
+    def reverse_or_stick(self, y: list[float]) -> list[float]:
+        """Speed crossed zero: reverse if the drive beats friction backwards, else stick."""
+        p = self.p
+        phi = y[0]
+        old = p.direction
+        for direction in (-old, old):
+            p.set_direction(direction, phi)
+            if direction * self.accel(phi, 0.0) > 0.0:
+                self._restart_branch(phi)
+                return [phi, 0.0, y[2]]
+        self.stuck = True
+        return [phi, 0.0, y[2]]
+
+    def try_unstick(self, phi: float) -> None:
+        """At rest: start in whichever direction the net torque beats static friction."""
+        p = self.p
+        held = p.direction
+        for direction in (held, -held):
+            p.set_direction(direction, phi)
+            if direction * self.accel(phi, 0.0) > 0.0:
+                self.stuck = False
+                self._restart_branch(phi)
+                return
+        # Stuck: keep the direction it had, so the outputs (and a master's exchange at
+        # this instant) do not flip between the two friction pieces from call to call.
+        p.set_direction(held, phi)
+        self.stuck = True
+
+    def _restart_branch(self, phi: float) -> None:
+        # The acceleration-dependent branches (I1R, normal-force signs) lag one accepted
+        # step; at a start from rest they take the new motion's acceleration at once, so
+        # the first step after it does not depend on its length.
+        self.p.update_i1r(0.0, self.accel(phi, 0.0))
+
+
+class _TrainModel(RestingTrainModel):
     """The train with a held escapement torque, as an EventModel; y = [phi, phi_d, W]."""
 
     def __init__(self, phys: TrainPhysics, t_esc: float) -> None:
@@ -495,34 +540,6 @@ class _TrainModel:
         if self.t_first_event < 0.0:
             self.t_first_event = t
         return self.reverse_or_stick(y)
-
-    def reverse_or_stick(self, y: list[float]) -> list[float]:
-        """Speed crossed zero: reverse if the drive beats friction backwards, else stick."""
-        p = self.p
-        phi = y[0]
-        old = p.direction
-        p.set_direction(-old, phi)
-        if -old * self.accel(phi, 0.0) > 0.0:
-            return y
-        p.set_direction(old, phi)
-        if old * self.accel(phi, 0.0) > 0.0:
-            return [phi, 0.0, y[2]]
-        self.stuck = True
-        return [phi, 0.0, y[2]]
-
-    def try_unstick(self, phi: float) -> None:
-        """At rest: start in whichever direction the net torque beats static friction."""
-        p = self.p
-        held = p.direction
-        for direction in (held, -held):
-            p.set_direction(direction, phi)
-            if direction * self.accel(phi, 0.0) > 0.0:
-                self.stuck = False
-                return
-        # Stuck: keep the direction it had, so the outputs (and a master's exchange at
-        # this instant) do not flip between the two friction pieces from call to call.
-        p.set_direction(held, phi)
-        self.stuck = True
 
 
 class TrainComponent(Component):

@@ -79,6 +79,9 @@ IND_WHEEL_SPEED = 4
 IND_MESH_HI = 5
 IND_MESH_LO = 6
 IND_STOP = 7
+# Wheel speed [rad/s] below which a located verge-speed zero in coupled motion is the
+# wheel's (psi_d = U phi_d with U of order 1; the event is located to about 1e-14 s).
+WHEEL_AT_REST = 1e-6
 
 
 def _sgn(x: float) -> int:
@@ -487,6 +490,10 @@ class VergeCore:
                 return y
             if index == IND_SLIDE:
                 return self._slide_reversal(y, t)
+            if abs(y[1]) < WHEEL_AT_REST:
+                # psi_d = U phi_d: the verge stops with the wheel, and its indicator fires
+                # first at the same instant; the wheel's own crossing would then be lost.
+                return self._wheel_reversal(y, t)
             self.s5 = -self.s5
             return y
         if index == IND_FACE_END:
@@ -582,6 +589,11 @@ class VergeCore:
                 self.log(self.t_base + t, FREE, FREE, "impact")
             y = [y[0], phi_f, y[2], psi_f, y[4]]
             y[4] += self._impact_loss(y, a1p, d1p)
+            if phi_f * self.train.direction < 0.0:
+                # A heavy verge throws the wheel back (recoil): the train's friction now
+                # opposes the backward motion (eq. 7); the wheel-speed indicator jumped
+                # through zero with the impact, so no crossing would flip it later.
+                self.train.set_direction(_sgn(phi_f), y[0])
             if self.face * (a1p * phi_f - d1p * psi_f) < -self.v_capture:
                 self.verge_stuck = False
                 self.s5 = _sgn(psi_f)
@@ -641,6 +653,12 @@ class VergeCore:
                 self.s5 = _sgn(u * d)
             acc = self.coupled_terms(y0)[0] if self.coupled else self.free_terms(y0)[0]
             if d * acc > 0.0:
+                # A start from rest: the lagged acceleration-dependent branches (I1R, I_PR)
+                # take the new motion (velocity x acceleration > 0) at once, so the first
+                # step after it does not depend on its length.
+                tr.update_i1r(0.0, acc)
+                if self.coupled:
+                    self.ipr_sign = 1
                 return y0
         tr.set_direction(old[0], y[0])
         self.s4, self.s5 = old[1], old[2]
@@ -656,7 +674,9 @@ class VergeCore:
         k = self.k
         phi_l = y[0] + self.phi_off
         vst = sliding_velocity(phi_l, y[2], y[1], y[3], self.alpha, k.b, k.c)
-        if vst == 0.0 or y[1] == 0.0:
+        if vst == 0.0 or abs(y[1]) < WHEEL_AT_REST:
+            # Coupled, V_S/T is proportional to phi_d: at a wheel stop it crosses zero with
+            # the wheel speed and fires first; decide the wheel's motion here.
             return self.decide_direction(y, t, self.train.direction)
         self.s4 = _sgn(vst)
         return y
@@ -796,7 +816,20 @@ class VergeEscapement(Component):
     def update_outputs(self) -> None:
         # Direct feedthrough: T_esc, PN and phi_ddot depend on the train's response and
         # on the wheel state; the internal state itself moves only in step().
-        self._outputs(self._take_inputs())
+        y = self._take_inputs()
+        core = self._core
+        if self.phi_dot == 0.0 and core.coupled and not core.train_stuck:
+            # Wheel at rest: give the static reaction (no wheel acceleration).  The train
+            # decides whether it starts with it, and sign(T_ref + c T_static) is the sign of
+            # the coupled acceleration; the reaction of an accelerating verge (the full
+            # T_esc) would hold a heavy verge's train at rest for ever.
+            core.train_stuck = True
+            try:
+                self._outputs(y)
+            finally:
+                core.train_stuck = False
+            return
+        self._outputs(y)
 
     def step(self, t: float, h: float) -> None:
         core = self._core

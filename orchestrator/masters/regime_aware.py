@@ -58,7 +58,7 @@ class Settings:
             max_step=o.get("max_step", min(100.0 * h, scene.stop - scene.start)),
             max_iterations=o.get("max_iterations", 10),
             max_events_per_step=o.get("max_events_per_step", 50),
-            midpoint=o.get("input_hold", "start") == "midpoint",
+            midpoint=o.get("input_hold", "midpoint") == "midpoint",
         )
 
 
@@ -129,11 +129,18 @@ class RegimeAwareMaster:
         self.stats.do_steps += len(system.instances)
 
     def corrected_trial(
-        self, t: float, h: float, before: _Snapshot, state: list[Any], predicted: list[list[float]]
+        self,
+        t: float,
+        h: float,
+        before: _Snapshot,
+        state: list[Any],
+        predicted: list[list[float]],
+        compare: list[list[float]] | None = None,
     ) -> None:
         """Retake the step [t, t+h] from the saved state with every held input at the mean
         of its start and ``predicted`` end values; ``self.ratio`` is the correction's size
-        against the tolerance (the predictor's error estimate)."""
+        (against the predictor's values at t+h, ``compare``, by default ``predicted``)
+        relative to the tolerance: the predictor's error estimate."""
         system = self.system
         system.set_state(state)  # the step-start outputs are read back as well
         self.stats.rollbacks += 1
@@ -155,8 +162,9 @@ class RegimeAwareMaster:
         self._step_all(t, h)
         worst, tol = 0.0, self.cfg.tolerance
         values = system.values
+        compare = predicted if compare is None else compare
         for i, k in self.outputs:
-            a, b = predicted[i][k], values[i][k]
+            a, b = compare[i][k], values[i][k]
             scale = self.out_scale[(i, k)] = max(self.out_scale[(i, k)], abs(start[i][k]), abs(b))
             if scale > 0.0:
                 worst = max(worst, abs(b - a) / (tol * scale))
@@ -308,6 +316,14 @@ class RegimeAwareMaster:
                 te = self.switch_time(t, h, before)
             if te is not None:
                 if t + h - te <= cfg.event_tolerance or h <= cfg.min_step:
+                    if cfg.midpoint and self.ratio > 1.0 and h > cfg.min_step:
+                        # The step onto the switch must pass the error test as well:
+                        # approach it in shorter steps (the held-input error at an impact
+                        # is the speed mismatch of the two sides, hence the energy).
+                        h = max(cfg.min_step, h * max(0.2, self._factor(self.ratio)))
+                        self._rollback(state)
+                        last_ratio = None
+                        continue
                     return h, te  # the step ends on the switch
                 # End the retaken step just past the located instant.
                 h = max(te - t + 0.5 * cfg.event_tolerance, cfg.min_step)
@@ -340,6 +356,7 @@ class RegimeAwareMaster:
         cfg = self.cfg
         if t + h - te > cfg.event_tolerance and h > cfg.min_step:
             return te
+        crossed = [list(v) for v in self.system.values]  # the predictor across the switch
         h_left = te - t - 0.5 * cfg.event_tolerance
         if h_left > 0.0:
             self.system.set_state(state)
@@ -348,7 +365,7 @@ class RegimeAwareMaster:
             predicted = [list(v) for v in self.system.values]
         else:
             predicted = before.values
-        self.corrected_trial(t, h, before, state, predicted)
+        self.corrected_trial(t, h, before, state, predicted, compare=crossed)
         return self.switch_time(t, h, before)
 
     def _factor(self, ratio: float) -> float:
