@@ -18,13 +18,20 @@ def run(tmp_path, fmu_cache, **overrides):
     return run_scene(scene, output_dir=tmp_path / "run", cache_dir=fmu_cache, show_progress=False)
 
 
-def test_error_follows_the_tolerance(tmp_path, fmu_cache) -> None:
+def test_error_follows_the_tolerance_with_inputs_held_at_the_step_start(
+    tmp_path, fmu_cache
+) -> None:
     errors = []
     for tol in (1e-2, 1e-3):
         result = run(
             tmp_path,
             fmu_cache,
-            **{"master.algorithm": "regime-aware", "master.tolerance": tol, "scene.stop": "0.1 s"},
+            **{
+                "master.algorithm": "regime-aware",
+                "master.input_hold": "start",
+                "master.tolerance": tol,
+                "scene.stop": "0.1 s",
+            },
         )
         assert result.status == "completed"
         errors.append(result.accuracy["trajectory_error"])
@@ -32,6 +39,24 @@ def test_error_follows_the_tolerance(tmp_path, fmu_cache) -> None:
     # Held inputs: the error is first order in the step, and the step follows the tolerance.
     assert errors[0] / errors[1] == pytest.approx(10.0, rel=0.3), errors
     assert errors[1] < 2e-3
+
+
+def test_midpoint_hold_is_second_order_in_the_step(tmp_path, fmu_cache) -> None:
+    errors, steps = [], []
+    for tol in (1e-3, 1e-4):
+        result = run(
+            tmp_path,
+            fmu_cache,
+            **{"master.algorithm": "regime-aware", "master.tolerance": tol, "scene.stop": "0.1 s"},
+        )
+        assert result.status == "completed"
+        errors.append(result.accuracy["trajectory_error"])
+        steps.append(result.stats.steps)
+    # The predictor's error is second order in h per step: steps grow as tol^-1/2, and the
+    # (corrected) error falls with the square of the step count, i.e. as the tolerance.
+    assert steps[1] / steps[0] == pytest.approx(10**0.5, rel=0.2), steps
+    assert errors[0] / errors[1] == pytest.approx((steps[1] / steps[0]) ** 2, rel=0.3), errors
+    assert errors[1] < 5e-4
 
 
 def test_stop_condition_is_landed_on_exactly(tmp_path, fmu_cache) -> None:

@@ -40,14 +40,15 @@ def test_pool_and_dask_give_identical_results(tmp_path: Path, fmu_cache, monkeyp
 def test_work_precision_report_for_the_two_inertias(tmp_path: Path, fmu_cache, monkeypatch) -> None:
     monkeypatch.setenv("MECHCOSIM_FMU_CACHE", str(fmu_cache))
     rows = work_precision(
-        SCENE, tmp_path / "wp", step_factors=(4.0, 2.0, 1.0), tolerances=(1e-2, 3e-3), workers=2
+        SCENE, tmp_path / "wp", step_factors=(4.0, 2.0, 1.0), tolerances=(1e-3, 1e-4), workers=2
     )
     assert len(rows) == 8 and all(r.result.status == "completed" for r in rows)
     for master in ("jacobi", "gauss-seidel"):
         assert observed_order(rows, master) == pytest.approx(1.0, abs=0.15)
     for name in ("work_precision.csv", "work_precision.png", "work_precision.md"):
         assert (tmp_path / "wp" / name).stat().st_size > 0
-    # The regime-aware master's error follows its tolerance.
+    # The regime-aware master's error follows its tolerance (the midpoint hold makes the
+    # steps grow as tol^-1/2 and the error fall as tol; 1e-2..3e-3 is pre-asymptotic).
     assert observed_order(rows, "regime-aware") == pytest.approx(1.0, abs=0.25)
     text = (tmp_path / "wp" / "work_precision.md").read_text()
     assert "Observed order" in text and "jacobi" in text
