@@ -71,7 +71,7 @@ from typing import Any
 
 from components.base import COMMON_OUTPUTS, ComponentError, Variable
 from components.clock_train import M739_TRAIN, ClockMesh, ClockTrain
-from components.gear_train import RestingTrainModel, TrainComponent
+from components.gear_train import TrainComponent, TrainLoadModel
 from components.m739_data import M739, M739Data
 
 LOSS_NONE = 0
@@ -419,7 +419,7 @@ class ClockTrainPhysics:
 # ------------------------------------------------------------------------------------------
 # Component
 # ------------------------------------------------------------------------------------------
-class _ClockModel(RestingTrainModel):
+class _ClockModel(TrainLoadModel):
     """The clock train with a held escapement torque, as an EventModel; y = [phi, phi_d, W].
 
     Indicators: piece bounds ahead (mesh 1, mesh 2), pitch points (mesh 1, mesh 2), speed.
@@ -432,10 +432,6 @@ class _ClockModel(RestingTrainModel):
         self.stuck = False
         self.t_first_event = -1.0  # first internal event inside the current step
 
-    def accel(self, phi: float, phi_dot: float) -> float:
-        j, t, c = self.p.response(phi, phi_dot)
-        return (t + c * self.t_esc) / j
-
     def deriv(self, y: list[float]) -> list[float]:
         if self.stuck:
             return [0.0, 0.0, 0.0]
@@ -443,7 +439,7 @@ class _ClockModel(RestingTrainModel):
         a = self.accel(phi, w)
         p_in, j0, g = self.p.power_terms(phi)
         # Dissipated power: input power minus rate of stored energy.
-        return [w, a, w * (self.t_esc + p_in - j0 * a - g * w * w)]
+        return [w, a, w * (self.load(a) + p_in - j0 * a - g * w * w)]
 
     def indicators(self, y: list[float]) -> tuple[float, ...]:
         p = self.p
@@ -498,6 +494,8 @@ class ClockGearTrain(TrainComponent):
             "drive": "T_ref",
             "load_factor": "c_load",
             "impact_inertia": "J_stot",
+            "static_torque": "T_esc_static",
+            "load_inertia": "J_esc",
         }
     }
 
@@ -515,6 +513,20 @@ class ClockGearTrain(TrainComponent):
         Variable("phi_dot_start", "parameter", "rad/s", 0.0, "initial escape-wheel speed"),
         Variable("h_max", "parameter", "s", 1.0e-6, "largest internal RK4 step"),
         Variable("T_esc", "input", "N.m", 0.0, "escapement moment on the escape wheel"),
+        Variable(
+            "T_esc_static",
+            "input",
+            "N.m",
+            0.0,
+            "escapement moment at zero wheel acceleration (used when J_esc != 0)",
+        ),
+        Variable(
+            "J_esc",
+            "input",
+            "kg.m2",
+            0.0,
+            "escapement inertia at the wheel: the load is T_esc_static - J_esc phi_ddot",
+        ),
         Variable(
             "impact_count",
             "input",
@@ -579,6 +591,7 @@ class ClockGearTrain(TrainComponent):
         self._y = [self.phi_start, self.phi_dot_start, 0.0]
         p.set_mode(self.phi_start, -1 if self.phi_dot_start < 0.0 else 1)
         self._model = _ClockModel(p, self.T_esc, self.J_load)
+        self._take_loads()
         self._seen_impacts = int(self.impact_count)
         self._cos0 = math.cos(p.rotor_angle(self.phi_start))
         self.t_event = -1.0
@@ -587,14 +600,14 @@ class ClockGearTrain(TrainComponent):
         self._outputs()
 
     def _take_loads(self) -> None:
-        self._model.t_esc = self.T_esc
+        super()._take_loads()
         self._model.j_load = self.J_load
 
     def _outputs(self) -> None:
         p, m = self._phys, self._model
         phi, w, wd = self._y
         j, tr, c = p.response(phi, w)
-        acc = 0.0 if m.stuck else (tr + c * self.T_esc) / j
+        acc = 0.0 if m.stuck else m.accel(phi, w)
         ev = p.evaluate(phi)
         self.phi, self.phi_dot, self.phi_ddot = phi, w, acc
         self.J_ref, self.T_ref, self.c_load = j, tr, c

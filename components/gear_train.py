@@ -455,15 +455,27 @@ class TrainPhysics:
 # ---------------------------------------------------------------------------------------
 # Component
 # ---------------------------------------------------------------------------------------
-class RestingTrainModel:
-    """Reversal, start and stick at zero wheel speed, for a train model with ``p`` (the
-    physics: direction, set_direction, update_i1r), ``accel(phi, phi_dot)`` and ``stuck``."""
+class TrainLoadModel:
+    """A train model's held escapement load and its motion at zero wheel speed.
+
+    The load is affine in the wheel acceleration, t_esc - j_esc phi_dd (j_esc = 0: a plain
+    held torque), so J_ref phi_dd = T_ref + c (t_esc - j_esc phi_dd).  Reversal, start and
+    stick at zero speed need ``p`` (the physics: response, direction, set_direction,
+    update_i1r) and ``stuck``.
+    """
 
     p: Any
     stuck: bool
+    t_esc: float = 0.0
+    j_esc: float = 0.0
 
     def accel(self, phi: float, phi_dot: float) -> float:
-        raise NotImplementedError
+        j, t, c = self.p.response(phi, phi_dot)
+        return (t + c * self.t_esc) / (j + c * self.j_esc)
+
+    def load(self, phi_ddot: float) -> float:
+        """The escapement moment on the wheel at this acceleration."""
+        return self.t_esc - self.j_esc * phi_ddot
 
     def reverse_or_stick(self, y: list[float]) -> list[float]:
         """Speed crossed zero: reverse if the drive beats friction backwards, else stick."""
@@ -500,7 +512,7 @@ class RestingTrainModel:
         self.p.update_i1r(0.0, self.accel(phi, 0.0))
 
 
-class _TrainModel(RestingTrainModel):
+class _TrainModel(TrainLoadModel):
     """The train with a held escapement torque, as an EventModel; y = [phi, phi_d, W]."""
 
     def __init__(self, phys: TrainPhysics, t_esc: float) -> None:
@@ -509,17 +521,13 @@ class _TrainModel(RestingTrainModel):
         self.stuck = False
         self.t_first_event = -1.0  # first reversal / stick inside the current step
 
-    def accel(self, phi: float, phi_dot: float) -> float:
-        j, t, c = self.p.response(phi, phi_dot)
-        return (t + c * self.t_esc) / j
-
     def deriv(self, y: list[float]) -> list[float]:
         if self.stuck:
             return [0.0, 0.0, 0.0]
         phi, w = y[0], y[1]
         a = self.accel(phi, w)
         # Dissipated power: input power minus rate of stored energy.
-        p_loss = w * (self.t_esc + self.p.drive_torque(phi) - self.p.i_stot * a)
+        p_loss = w * (self.load(a) + self.p.drive_torque(phi) - self.p.i_stot * a)
         return [w, a, p_loss]
 
     def indicators(self, y: list[float]) -> tuple[float, float, float]:
@@ -554,8 +562,11 @@ class TrainComponent(Component):
     _MODEL: type
 
     def _take_loads(self) -> None:
-        """Copy the held inputs the model integrates with."""
-        self._model.t_esc = self.T_esc
+        """Copy the held inputs the model integrates with: the escapement as an affine
+        load when its inertia at the wheel is given, else the plain torque."""
+        m = self._model
+        m.j_esc = self.J_esc
+        m.t_esc = self.T_esc_static if self.J_esc != 0.0 else self.T_esc
 
     def _apply_inputs(self) -> None:
         """Take a new impact speed (once per impact_count change) and the held load.
@@ -641,6 +652,8 @@ class GearTrain(TrainComponent):
             "drive": "T_ref",
             "load_factor": "c_load",
             "impact_inertia": "J_stot",
+            "static_torque": "T_esc_static",
+            "load_inertia": "J_esc",
         }
     }
 
@@ -652,6 +665,20 @@ class GearTrain(TrainComponent):
         Variable("phi_dot_start", "parameter", "rad/s", 0.0, "initial escape-wheel speed"),
         Variable("h_max", "parameter", "s", 1.0e-6, "largest internal RK4 step"),
         Variable("T_esc", "input", "N.m", 0.0, "escapement moment on the escape wheel"),
+        Variable(
+            "T_esc_static",
+            "input",
+            "N.m",
+            0.0,
+            "escapement moment at zero wheel acceleration (used when J_esc != 0)",
+        ),
+        Variable(
+            "J_esc",
+            "input",
+            "kg.m2",
+            0.0,
+            "escapement inertia at the wheel: the load is T_esc_static - J_esc phi_ddot",
+        ),
         # Impact inputs are events taken once, not signals held over the step.
         Variable(
             "impact_count",
@@ -693,6 +720,7 @@ class GearTrain(TrainComponent):
         direction = -1 if self.phi_dot_start < 0.0 else 1
         self._phys.set_mode(self.phi_start, direction)
         self._model = _TrainModel(self._phys, self.T_esc)
+        self._take_loads()
         self._seen_impacts = int(self.impact_count)
         self._cos0 = math.cos(M739.phi1c + self._phys.n31 * self.phi_start)
         self.t_event = -1.0
@@ -704,7 +732,7 @@ class GearTrain(TrainComponent):
         p, m = self._phys, self._model
         phi, w, wd = self._y
         j, tr, c = p.response(phi, w)
-        acc = 0.0 if m.stuck else (tr + c * self.T_esc) / j
+        acc = 0.0 if m.stuck else m.accel(phi, w)
         self.phi, self.phi_dot, self.phi_ddot = phi, w, acc
         self.J_ref, self.T_ref, self.c_load, self.J_stot = j, tr, c, p.i_stot
         f12, f23 = p.forces(phi, w, acc)

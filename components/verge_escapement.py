@@ -376,7 +376,8 @@ class VergeCore:
 
     def coupled_terms(self, y: list[float]) -> tuple[float, ...]:
         """Coupled regime at y: (phi_dd, psi, psi_d, psi_dd, Pn, T_esc, g, U, V_S/T, J_eff,
-        centrifugal verge moment)."""
+        centrifugal verge moment, T_esc at zero wheel acceleration, J_esc) with
+        T_esc = T_esc_static - J_esc phi_dd (the escapement as an affine load on the wheel)."""
         # Memo of the last evaluation: indicators, accept and the next stage-1 derivative
         # all ask for the same point; the key covers everything the result depends on.
         key = (y[0], y[1], self._mode_key())
@@ -413,7 +414,23 @@ class VergeCore:
         pn = (ipr * psi_dd + a21 * psi_d * psi_d + a52 * psi_d + k.om2 * a19 - cent) / a18
         vst = sliding_velocity(phi_l, psi, w, psi_d, alpha, k.b, k.c)
         # den / a18: effective inertia at the wheel, must stay positive (else self-locking)
-        return acc, psi, psi_d, psi_dd, pn, -a17 * pn, g, u, vst, den / a18, cent
+        t_static = -a17 * (ipr * v * w * w + a21 * psi_d * psi_d + a52 * psi_d + k.om2 * a19 - cent)
+        j_esc = a17 * ipr * u
+        return (
+            acc,
+            psi,
+            psi_d,
+            psi_dd,
+            pn,
+            -a17 * pn,
+            g,
+            u,
+            vst,
+            den / a18,
+            cent,
+            t_static / a18,
+            j_esc / a18,
+        )
 
     def free_terms(self, y: list[float]) -> tuple[float, float, float]:
         """(phi_dd, psi_dd, centrifugal verge moment) in free motion (B187, B193)."""
@@ -439,7 +456,7 @@ class VergeCore:
     def deriv(self, y: list[float]) -> list[float]:
         w = y[1]
         if self.coupled:
-            acc, _, psi_d, psi_dd, _, t_esc, *_, cent = self.coupled_terms(y)
+            acc, _, psi_d, psi_dd, _, t_esc, *_, cent, _, _ = self.coupled_terms(y)
             # Power balance of the verge side: input -T_esc phi_d minus d/dt(stored).
             p = -t_esc * w - self.k.ip * psi_d * psi_dd + cent * psi_d
             return [w, acc, psi_d, psi_dd, p]
@@ -454,7 +471,7 @@ class VergeCore:
         wheel = 1.0 if self.train_stuck else self.train.direction * y[1]
         stop = self.phi_stop - y[0]
         if self.coupled:
-            _, _, psi_d, _, pn, _, g, _, vst, _, _ = self.coupled_terms(y)
+            _, _, psi_d, _, pn, _, g, _, vst, *_ = self.coupled_terms(y)
             return (sigma * g, pn, self.s4 * vst, self.s5 * psi_d, wheel, hi, lo, stop)
         phi_l = y[0] + self.phi_off
         psi = y[2]
@@ -699,6 +716,10 @@ class VergeEscapement(Component):
 
     Port ``escape_wheel``: angle and speed (in), torque T_esc (out), and the train's
     affine response (inertia J_ref, drive T_ref, load_factor c_load, impact_inertia J_stot).
+    The other way the escapement is an affine load: T_esc = T_esc_static - J_esc phi_ddot
+    (static_torque, load_inertia out), so that a train holding these over a step follows
+    the coupled acceleration even where drive and reaction nearly cancel (a heavy verge),
+    and decides a start from rest on the static reaction.
     """
 
     REGIME_NAMES = REGIME_NAMES
@@ -711,6 +732,8 @@ class VergeEscapement(Component):
             "drive": "T_ref",
             "load_factor": "c_load",
             "impact_inertia": "J_stot",
+            "static_torque": "T_esc_static",
+            "load_inertia": "J_esc",
         }
     }
 
@@ -759,6 +782,14 @@ class VergeEscapement(Component):
         Variable("psi_local", "output", "rad", 0.0, "verge angle in the active face's frame"),
         Variable("phi_local", "output", "rad", M739.phi_start, "wheel angle, active face frame"),
         Variable("T_esc", "output", "N.m", 0.0, "escapement moment on the escape wheel"),
+        Variable(
+            "T_esc_static",
+            "output",
+            "N.m",
+            0.0,
+            "T_esc at zero wheel acceleration: T_esc = T_esc_static - J_esc phi_ddot",
+        ),
+        Variable("J_esc", "output", "kg.m2", 0.0, "escapement inertia felt at the wheel (coupled)"),
         Variable("phi_ddot", "output", "rad/s2", 0.0, "escape-wheel acceleration (own)"),
         Variable("phi_dot_own", "output", "rad/s", 0.0, "escape-wheel speed (own copy)"),
         Variable("PN", "output", "N", 0.0, "tooth-face normal force (coupled)"),
@@ -816,20 +847,7 @@ class VergeEscapement(Component):
     def update_outputs(self) -> None:
         # Direct feedthrough: T_esc, PN and phi_ddot depend on the train's response and
         # on the wheel state; the internal state itself moves only in step().
-        y = self._take_inputs()
-        core = self._core
-        if self.phi_dot == 0.0 and core.coupled and not core.train_stuck:
-            # Wheel at rest: give the static reaction (no wheel acceleration).  The train
-            # decides whether it starts with it, and sign(T_ref + c T_static) is the sign of
-            # the coupled acceleration; the reaction of an accelerating verge (the full
-            # T_esc) would hold a heavy verge's train at rest for ever.
-            core.train_stuck = True
-            try:
-                self._outputs(y)
-            finally:
-                core.train_stuck = False
-            return
-        self._outputs(y)
+        self._outputs(self._take_inputs())
 
     def step(self, t: float, h: float) -> None:
         core = self._core
@@ -897,8 +915,9 @@ class VergeEscapement(Component):
         core = self._core
         k = core.k
         if core.coupled:
-            acc, psi, psi_d, _, pn, t_esc, g, u, *_ = core.coupled_terms(y)
+            acc, psi, psi_d, _, pn, t_esc, g, u, *_, t_static, j_esc = core.coupled_terms(y)
             self.PN, self.T_esc, self.ind_pn = pn, t_esc, pn
+            self.T_esc_static, self.J_esc = t_static, j_esc
             self.J_load = k.ip * u * u
             self.ind_face_end = core.face * g
             self.ind_gap = 0.0
@@ -906,6 +925,7 @@ class VergeEscapement(Component):
             acc = core.free_terms(y)[0]
             psi, psi_d = y[2], y[3]
             self.PN = self.T_esc = self.ind_pn = self.J_load = 0.0
+            self.T_esc_static = self.J_esc = 0.0
             ind = core.indicators(y)
             self.ind_face_end, self.ind_gap = ind[IND_FACE_END], ind[IND_CONTACT]
         self.v_close = core.closing_speed(y)[0]

@@ -70,7 +70,7 @@ class _Monolithic(VergeCore):
         """Forces at an accepted point (OUTP / OUTPF of the report)."""
         tr = self.train
         if self.coupled:
-            acc, _, _, _, pn, _, _, _, _, den, _ = self.coupled_terms(y)
+            acc, _, _, _, pn, _, _, _, _, den, *_ = self.coupled_terms(y)
             j = tr.response(y[0], y[1])[0]
             if den <= 0.0 or j <= 0.0:
                 self.fault = "self-locking: effective inertia not positive"
