@@ -65,6 +65,12 @@ def main(argv: list[str] | None = None) -> int:
         type=_floats,
         help="fixed-step macro steps as multiples of the scene's (default 8,...,0.25)",
     )
+    p.add_argument(
+        "--start-hold-tolerances",
+        type=_floats,
+        help="also run the regime-aware master with inputs held at the step start "
+        "(input_hold = 'start', the first-order error test) at these tolerances",
+    )
     p.set_defaults(handler=_precision)
 
     p = sub.add_parser("sweep", help="run a scene's [sweep]: one run per value, CSV/PNG/table")
@@ -211,11 +217,12 @@ def _precision(args: argparse.Namespace) -> int:
         args.output,
         step_factors=args.step_factors or STEP_FACTORS,
         tolerances=args.tolerances or TOLERANCES,
+        start_hold_tolerances=args.start_hold_tolerances or (),
         workers=args.workers,
         dask_address=args.dask,
     )
     for master in dict.fromkeys(r.master for r in rows):
-        print(f"  {master:14s} observed order {observed_order(rows, master):.2f}")
+        print(f"  {master:20s} observed order {observed_order(rows, master):.2f}")
     out = Path(rows[0].result.job.output_dir).parent if rows else args.output
     print(f"report in {out}/work_precision.md (.csv, .png)")
     return 0

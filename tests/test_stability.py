@@ -9,6 +9,8 @@ from orchestrator.stability import case_files, run_suite
 EXPECTED_STABLE = {
     "m739_friction_zero",
     "m739_jam",
+    "m739_pallet_inertia_div100",
+    "m739_pallet_inertia_x100",
     "m739_spin_x4",
     "press_feed_brake_below_min",
     "press_feed_brake_near_min",

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from orchestrator.sweep import Job, run_jobs
-from orchestrator.work_precision import observed_order, work_precision
+from orchestrator.work_precision import START_HOLD, observed_order, work_precision
 
 SCENE = Path(__file__).resolve().parent.parent / "scenarios" / "two_inertias.toml"
 
@@ -40,9 +40,18 @@ def test_pool_and_dask_give_identical_results(tmp_path: Path, fmu_cache, monkeyp
 def test_work_precision_report_for_the_two_inertias(tmp_path: Path, fmu_cache, monkeypatch) -> None:
     monkeypatch.setenv("MECHCOSIM_FMU_CACHE", str(fmu_cache))
     rows = work_precision(
-        SCENE, tmp_path / "wp", step_factors=(4.0, 2.0, 1.0), tolerances=(1e-3, 1e-4), workers=2
+        SCENE,
+        tmp_path / "wp",
+        step_factors=(4.0, 2.0, 1.0),
+        tolerances=(1e-3, 1e-4),
+        workers=2,
+        start_hold_tolerances=(1e-3,),
     )
-    assert len(rows) == 8 and all(r.result.status == "completed" for r in rows)
+    assert len(rows) == 9 and all(r.result.status == "completed" for r in rows)
+    # The baseline (inputs held at the step start) at the same tolerance takes more steps.
+    start = next(r for r in rows if r.master == START_HOLD)
+    mid = next(r for r in rows if r.master == "regime-aware" and r.value == 1e-3)
+    assert start.result.stats["steps"] > 2 * mid.result.stats["steps"]
     for master in ("jacobi", "gauss-seidel"):
         assert observed_order(rows, master) == pytest.approx(1.0, abs=0.15)
     for name in ("work_precision.csv", "work_precision.png", "work_precision.md"):
@@ -51,4 +60,4 @@ def test_work_precision_report_for_the_two_inertias(tmp_path: Path, fmu_cache, m
     # steps grow as tol^-1/2 and the error fall as tol; 1e-2..3e-3 is pre-asymptotic).
     assert observed_order(rows, "regime-aware") == pytest.approx(1.0, abs=0.25)
     text = (tmp_path / "wp" / "work_precision.md").read_text()
-    assert "Observed order" in text and "jacobi" in text
+    assert "Observed order" in text and "jacobi" in text and "event-time error" in text
