@@ -134,7 +134,9 @@ def work_precision(
         )
         rows.append(Row(job.label, setting, value, res, accuracy))
     _write_csv(rows, out_dir / "work_precision.csv")
-    _plot(rows, reference.wall_time, scene.name, out_dir / "work_precision.png")
+    plot_records(
+        [r.as_dict() for r in rows], reference.wall_time, scene.name, out_dir / "work_precision.png"
+    )
     _write_summary(rows, scene, reference.wall_time, out_dir / "work_precision.md")
     return rows
 
@@ -161,25 +163,28 @@ def _write_csv(rows: list[Row], path: Path) -> None:
             writer.writerow(r.as_dict())
 
 
-def _plot(rows: list[Row], reference_time: float, name: str, path: Path) -> None:
+def plot_records(records: list[dict[str, Any]], reference_time: float, name: str, path: Path):
+    """The diagram from table rows (``Row.as_dict`` or the CSV read back with float values)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    from matplotlib.ticker import NullFormatter
 
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.5))
     for ax, error in zip(axes, ("trajectory_error", "headline_error"), strict=True):
-        for master in dict.fromkeys(r.master for r in rows):
+        for master in dict.fromkeys(r["master"] for r in records):
             pts = [
-                (r.result.stats["wall_time"], r.accuracy.get(error, math.nan))
-                for r in rows
-                if r.master == master and r.result.status == "completed"
+                (float(r["wall_time"]), float(r[error]))
+                for r in records
+                if r["master"] == master and r["status"] == "completed"
             ]
             pts = sorted((x, y) for x, y in pts if y > 0 and math.isfinite(y))
             if pts:
                 ax.loglog(*zip(*pts, strict=True), "o-", label=master)
         if reference_time > 0:
             ax.axvline(reference_time, color="grey", ls=":", label="reference run time")
+        ax.xaxis.set_minor_formatter(NullFormatter())  # minor labels collide on short spans
         ax.set_xlabel("wall time [s]")
         ax.set_ylabel(error.replace("_", " ") + " (relative)")
         ax.grid(True, which="both", alpha=0.3)
