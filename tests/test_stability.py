@@ -41,8 +41,10 @@ def test_regime_aware_master_is_stable_within_its_stated_error(rows, case) -> No
 
 
 def test_elastic_impacts_stay_energy_consistent(rows) -> None:
-    # Restitution 1 makes the tooth bounce; the run keeps its energy balance, but its
-    # trajectory departs from the reference's (see the issue note): not claimed stable.
+    # Restitution 1 makes the tooth bounce; the run keeps its energy balance.  Its
+    # trajectory error is now just inside the case's bound (9.0e-4 against 1e-3 with the
+    # midpoint hold; it was outside with inputs held at the step start), too narrow a
+    # margin to claim: only the energy balance is asserted.
     row = rows["m739_elastic_impacts"]
     assert row.status == "completed"
     assert row.energy_residual < 1e-3
