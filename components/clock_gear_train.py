@@ -71,7 +71,12 @@ from typing import Any
 
 from components.base import COMMON_OUTPUTS, ComponentError, Variable
 from components.clock_train import M739_TRAIN, ClockMesh, ClockTrain
-from components.gear_train import TrainComponent, TrainLoadModel
+from components.gear_train import (
+    ESCAPE_WHEEL_PORT,
+    ESCAPE_WHEEL_VARIABLES,
+    TrainComponent,
+    TrainLoadModel,
+)
 from components.m739_data import M739, M739Data
 
 LOSS_NONE = 0
@@ -425,12 +430,9 @@ class _ClockModel(TrainLoadModel):
     Indicators: piece bounds ahead (mesh 1, mesh 2), pitch points (mesh 1, mesh 2), speed.
     """
 
-    def __init__(self, phys: ClockTrainPhysics, t_esc: float, j_load: float) -> None:
-        self.p = phys
-        self.t_esc = t_esc
-        self.j_load = j_load
-        self.stuck = False
-        self.t_first_event = -1.0  # first internal event inside the current step
+    def __init__(self, phys: ClockTrainPhysics) -> None:
+        super().__init__(phys)
+        self.j_load = 0.0  # inertia riding on the wheel (handovers); from the inputs
 
     def deriv(self, y: list[float]) -> list[float]:
         if self.stuck:
@@ -485,19 +487,7 @@ class ClockGearTrain(TrainComponent):
     REGIME_NAMES = REGIME_NAMES
     _PHYSICS = ClockTrainPhysics
     _MODEL = _ClockModel
-    PORTS = {
-        "escape_wheel": {
-            "angle": "phi",
-            "speed": "phi_dot",
-            "torque": "T_esc",
-            "inertia": "J_ref",
-            "drive": "T_ref",
-            "load_factor": "c_load",
-            "impact_inertia": "J_stot",
-            "static_torque": "T_esc_static",
-            "load_inertia": "J_esc",
-        }
-    }
+    PORTS = {"escape_wheel": ESCAPE_WHEEL_PORT}
 
     VARIABLES = (
         Variable("mu", "parameter", "1", M739.mu, "Coulomb friction, mesh contacts and pivots"),
@@ -512,43 +502,10 @@ class ClockGearTrain(TrainComponent):
         Variable("phi_start", "parameter", "rad", 0.0, "initial cumulative escape-wheel angle"),
         Variable("phi_dot_start", "parameter", "rad/s", 0.0, "initial escape-wheel speed"),
         Variable("h_max", "parameter", "s", 1.0e-6, "largest internal RK4 step"),
-        Variable("T_esc", "input", "N.m", 0.0, "escapement moment on the escape wheel"),
-        Variable(
-            "T_esc_static",
-            "input",
-            "N.m",
-            0.0,
-            "escapement moment at zero wheel acceleration (used when J_esc != 0)",
-        ),
-        Variable(
-            "J_esc",
-            "input",
-            "kg.m2",
-            0.0,
-            "escapement inertia at the wheel: the load is T_esc_static - J_esc phi_ddot",
-        ),
-        Variable(
-            "impact_count",
-            "input",
-            "1",
-            0,
-            "incremented by the master at an impact",
-            "Integer",
-            sampled=True,
-        ),
-        Variable(
-            "phi_dot_impact", "input", "rad/s", 0.0, "escape-wheel speed after impact", sampled=True
-        ),
+        *ESCAPE_WHEEL_VARIABLES,
         Variable(
             "J_load", "input", "kg.m2", 0.0, "inertia riding on the wheel (handover)", sampled=True
         ),
-        Variable("phi", "output", "rad", 0.0, "cumulative escape-wheel angle"),
-        Variable("phi_dot", "output", "rad/s", 0.0, "escape-wheel speed"),
-        Variable("phi_ddot", "output", "rad/s2", 0.0, "escape-wheel acceleration"),
-        Variable("J_ref", "output", "kg.m2", 0.0, "effective inertia at the escape wheel"),
-        Variable("T_ref", "output", "N.m", 0.0, "net train torque at the escape wheel"),
-        Variable("c_load", "output", "1", 1.0, "factor of T_esc in J_ref phi_dd = T_ref + c T_esc"),
-        Variable("J_stot", "output", "kg.m2", 0.0, "frictionless reflected inertia"),
         Variable("F12", "output", "N", 0.0, "mesh-1 normal force (any regime)"),
         Variable("F23", "output", "N", 0.0, "mesh-2 normal force (any regime)"),
         Variable("FF12", "output", "N", 0.0, "mesh-1 force when unloaded (T_esc = 0), else 0"),
@@ -590,7 +547,7 @@ class ClockGearTrain(TrainComponent):
         p = self._phys
         self._y = [self.phi_start, self.phi_dot_start, 0.0]
         p.set_mode(self.phi_start, -1 if self.phi_dot_start < 0.0 else 1)
-        self._model = _ClockModel(p, self.T_esc, self.J_load)
+        self._model = _ClockModel(p)
         self._take_loads()
         self._seen_impacts = int(self.impact_count)
         self._cos0 = math.cos(p.rotor_angle(self.phi_start))

@@ -464,10 +464,12 @@ class TrainLoadModel:
     update_i1r) and ``stuck``.
     """
 
-    p: Any
-    stuck: bool
-    t_esc: float = 0.0
-    j_esc: float = 0.0
+    def __init__(self, phys: Any) -> None:
+        self.p = phys
+        self.t_esc = 0.0  # the held load; set from the inputs by TrainComponent._take_loads
+        self.j_esc = 0.0
+        self.stuck = False
+        self.t_first_event = -1.0  # first internal event (reversal, stick) in the step
 
     def accel(self, phi: float, phi_dot: float) -> float:
         j, t, c = self.p.response(phi, phi_dot)
@@ -515,12 +517,6 @@ class TrainLoadModel:
 class _TrainModel(TrainLoadModel):
     """The train with a held escapement torque, as an EventModel; y = [phi, phi_d, W]."""
 
-    def __init__(self, phys: TrainPhysics, t_esc: float) -> None:
-        self.p = phys
-        self.t_esc = t_esc
-        self.stuck = False
-        self.t_first_event = -1.0  # first reversal / stick inside the current step
-
     def deriv(self, y: list[float]) -> list[float]:
         if self.stuck:
             return [0.0, 0.0, 0.0]
@@ -548,6 +544,61 @@ class _TrainModel(TrainLoadModel):
         if self.t_first_event < 0.0:
             self.t_first_event = t
         return self.reverse_or_stick(y)
+
+
+#: The escape-wheel port of a spin-driven train, and of the verge on the other side: the
+#: train sends the wheel state and its affine response, the verge the escapement moment
+#: and its affine form (T_esc = T_esc_static - J_esc phi_ddot).
+ESCAPE_WHEEL_PORT = {
+    "angle": "phi",
+    "speed": "phi_dot",
+    "torque": "T_esc",
+    "inertia": "J_ref",
+    "drive": "T_ref",
+    "load_factor": "c_load",
+    "impact_inertia": "J_stot",
+    "static_torque": "T_esc_static",
+    "load_inertia": "J_esc",
+}
+
+#: The train side of that port.  Impact inputs are events taken once, not signals held
+#: over the step.
+ESCAPE_WHEEL_VARIABLES = (
+    Variable("T_esc", "input", "N.m", 0.0, "escapement moment on the escape wheel"),
+    Variable(
+        "T_esc_static",
+        "input",
+        "N.m",
+        0.0,
+        "escapement moment at zero wheel acceleration (used when J_esc != 0)",
+    ),
+    Variable(
+        "J_esc",
+        "input",
+        "kg.m2",
+        0.0,
+        "escapement inertia at the wheel: the load is T_esc_static - J_esc phi_ddot",
+    ),
+    Variable(
+        "impact_count",
+        "input",
+        "1",
+        0,
+        "incremented by the master at an impact",
+        "Integer",
+        sampled=True,
+    ),
+    Variable(
+        "phi_dot_impact", "input", "rad/s", 0.0, "escape-wheel speed after impact", sampled=True
+    ),
+    Variable("phi", "output", "rad", 0.0, "cumulative escape-wheel angle"),
+    Variable("phi_dot", "output", "rad/s", 0.0, "escape-wheel speed"),
+    Variable("phi_ddot", "output", "rad/s2", 0.0, "escape-wheel acceleration"),
+    Variable("J_ref", "output", "kg.m2", 0.0, "effective inertia at the escape wheel"),
+    Variable("T_ref", "output", "N.m", 0.0, "net train torque at the escape wheel"),
+    Variable("c_load", "output", "1", 1.0, "factor of T_esc in J_ref phi_dd = T_ref + c T_esc"),
+    Variable("J_stot", "output", "kg.m2", 0.0, "frictionless reflected inertia (impacts, B213)"),
+)
 
 
 class TrainComponent(Component):
@@ -643,19 +694,7 @@ class GearTrain(TrainComponent):
     REGIME_NAMES = TRAIN_REGIME_NAMES
     _PHYSICS = TrainPhysics
     _MODEL = _TrainModel
-    PORTS = {
-        "escape_wheel": {
-            "angle": "phi",
-            "speed": "phi_dot",
-            "torque": "T_esc",
-            "inertia": "J_ref",
-            "drive": "T_ref",
-            "load_factor": "c_load",
-            "impact_inertia": "J_stot",
-            "static_torque": "T_esc_static",
-            "load_inertia": "J_esc",
-        }
-    }
+    PORTS = {"escape_wheel": ESCAPE_WHEEL_PORT}
 
     VARIABLES = (
         Variable("mu", "parameter", "1", M739.mu, "Coulomb friction, teeth and train pivots"),
@@ -664,41 +703,7 @@ class GearTrain(TrainComponent):
         Variable("phi_start", "parameter", "rad", 0.0, "initial cumulative escape-wheel angle"),
         Variable("phi_dot_start", "parameter", "rad/s", 0.0, "initial escape-wheel speed"),
         Variable("h_max", "parameter", "s", 1.0e-6, "largest internal RK4 step"),
-        Variable("T_esc", "input", "N.m", 0.0, "escapement moment on the escape wheel"),
-        Variable(
-            "T_esc_static",
-            "input",
-            "N.m",
-            0.0,
-            "escapement moment at zero wheel acceleration (used when J_esc != 0)",
-        ),
-        Variable(
-            "J_esc",
-            "input",
-            "kg.m2",
-            0.0,
-            "escapement inertia at the wheel: the load is T_esc_static - J_esc phi_ddot",
-        ),
-        # Impact inputs are events taken once, not signals held over the step.
-        Variable(
-            "impact_count",
-            "input",
-            "1",
-            0,
-            "incremented by the master at an impact",
-            "Integer",
-            sampled=True,
-        ),
-        Variable(
-            "phi_dot_impact", "input", "rad/s", 0.0, "escape-wheel speed after impact", sampled=True
-        ),
-        Variable("phi", "output", "rad", 0.0, "cumulative escape-wheel angle"),
-        Variable("phi_dot", "output", "rad/s", 0.0, "escape-wheel speed"),
-        Variable("phi_ddot", "output", "rad/s2", 0.0, "escape-wheel acceleration"),
-        Variable("J_ref", "output", "kg.m2", 0.0, "effective inertia at the escape wheel"),
-        Variable("T_ref", "output", "N.m", 0.0, "net train torque at the escape wheel"),
-        Variable("c_load", "output", "1", 1.0, "factor of T_esc in J_ref phi_dd = T_ref + c T_esc"),
-        Variable("J_stot", "output", "kg.m2", 0.0, "frictionless reflected inertia (B213)"),
+        *ESCAPE_WHEEL_VARIABLES,
         Variable("F12", "output", "N", 0.0, "mesh-1 contact force (any regime)"),
         Variable("F23", "output", "N", 0.0, "mesh-2 contact force (any regime)"),
         Variable("FF12", "output", "N", 0.0, "mesh-1 force when unloaded (T_esc = 0), else 0"),
@@ -719,7 +724,7 @@ class GearTrain(TrainComponent):
         self._y = [self.phi_start, self.phi_dot_start, 0.0]
         direction = -1 if self.phi_dot_start < 0.0 else 1
         self._phys.set_mode(self.phi_start, direction)
-        self._model = _TrainModel(self._phys, self.T_esc)
+        self._model = _TrainModel(self._phys)
         self._take_loads()
         self._seen_impacts = int(self.impact_count)
         self._cos0 = math.cos(M739.phi1c + self._phys.n31 * self.phi_start)

@@ -51,7 +51,7 @@ from collections.abc import Callable
 from typing import Any
 
 from components.base import COMMON_OUTPUTS, Component, ComponentError, Variable
-from components.gear_train import advance
+from components.gear_train import ESCAPE_WHEEL_PORT, advance
 from components.m739_data import M739, M739Data
 from components.verge_geometry import (
     TWO_PI,
@@ -413,24 +413,10 @@ class VergeCore:
         psi_dd = u * acc + v * w * w
         pn = (ipr * psi_dd + a21 * psi_d * psi_d + a52 * psi_d + k.om2 * a19 - cent) / a18
         vst = sliding_velocity(phi_l, psi, w, psi_d, alpha, k.b, k.c)
-        # den / a18: effective inertia at the wheel, must stay positive (else self-locking)
-        t_static = -a17 * (ipr * v * w * w + a21 * psi_d * psi_d + a52 * psi_d + k.om2 * a19 - cent)
-        j_esc = a17 * ipr * u
-        return (
-            acc,
-            psi,
-            psi_d,
-            psi_dd,
-            pn,
-            -a17 * pn,
-            g,
-            u,
-            vst,
-            den / a18,
-            cent,
-            t_static / a18,
-            j_esc / a18,
-        )
+        # den / a18: effective inertia at the wheel, must stay positive (else self-locking).
+        # T_esc = -A17 Pn is affine in acc: -A17 n / A18 at acc = 0, slope -A17 I_PR U / A18.
+        t_static, j_esc = -a17 * n / a18, a17 * ipr * u / a18
+        return acc, psi, psi_d, psi_dd, pn, -a17 * pn, g, u, vst, den / a18, cent, t_static, j_esc
 
     def free_terms(self, y: list[float]) -> tuple[float, float, float]:
         """(phi_dd, psi_dd, centrifugal verge moment) in free motion (B187, B193)."""
@@ -505,12 +491,12 @@ class VergeCore:
                 y = self._sync_kinematics(y)
                 self._switch(t, FREE, "separation Pn = 0")
                 return y
+            if index in (IND_SLIDE, IND_VERGE_SPEED) and abs(y[1]) < WHEEL_AT_REST:
+                # psi_d = U phi_d and V_S/T ~ phi_d: at a wheel stop these indicators cross
+                # with the wheel speed and fire first; the wheel's own crossing is then lost.
+                return self._wheel_reversal(y, t)
             if index == IND_SLIDE:
                 return self._slide_reversal(y, t)
-            if abs(y[1]) < WHEEL_AT_REST:
-                # psi_d = U phi_d: the verge stops with the wheel, and its indicator fires
-                # first at the same instant; the wheel's own crossing would then be lost.
-                return self._wheel_reversal(y, t)
             self.s5 = -self.s5
             return y
         if index == IND_FACE_END:
@@ -691,9 +677,7 @@ class VergeCore:
         k = self.k
         phi_l = y[0] + self.phi_off
         vst = sliding_velocity(phi_l, y[2], y[1], y[3], self.alpha, k.b, k.c)
-        if vst == 0.0 or abs(y[1]) < WHEEL_AT_REST:
-            # Coupled, V_S/T is proportional to phi_d: at a wheel stop it crosses zero with
-            # the wheel speed and fires first; decide the wheel's motion here.
+        if vst == 0.0 or y[1] == 0.0:
             return self.decide_direction(y, t, self.train.direction)
         self.s4 = _sgn(vst)
         return y
@@ -723,19 +707,7 @@ class VergeEscapement(Component):
     """
 
     REGIME_NAMES = REGIME_NAMES
-    PORTS = {
-        "escape_wheel": {
-            "angle": "phi",
-            "speed": "phi_dot",
-            "torque": "T_esc",
-            "inertia": "J_ref",
-            "drive": "T_ref",
-            "load_factor": "c_load",
-            "impact_inertia": "J_stot",
-            "static_torque": "T_esc_static",
-            "load_inertia": "J_esc",
-        }
-    }
+    PORTS = {"escape_wheel": ESCAPE_WHEEL_PORT}
 
     VARIABLES = (
         Variable("mu1", "parameter", "1", M739.mu1, "friction, tooth-face and verge pivot"),

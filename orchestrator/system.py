@@ -137,12 +137,15 @@ class CoupledSystem:
         for i in range(len(self.instances)):
             self.read(i)
 
-    def feed(self, i: int) -> None:
-        """Set instance i's inputs from the latest values read from its sources."""
+    def feed(self, i: int, reals: list[float] | None = None) -> None:
+        """Set instance i's inputs from the latest values read from its sources (its Real
+        inputs from ``reals`` instead, when given, in the order of ``feeds[i]``)."""
         feed = self.feeds[i]
         if feed.real_refs:
-            values = self.values
-            self.instances[i].set_real(feed.real_refs, [values[s][k] for s, k in feed.real_sources])
+            if reals is None:
+                values = self.values
+                reals = [values[s][k] for s, k in feed.real_sources]
+            self.instances[i].set_real(feed.real_refs, reals)
         if feed.int_refs:
             ints = self.ints
             self.instances[i].set_integer(feed.int_refs, [ints[s][k] for s, k in feed.int_sources])

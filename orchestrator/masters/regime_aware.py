@@ -81,22 +81,20 @@ class RegimeAwareMaster:
         self.log = RegimeLog(system, scene, recorder)
         # Exchanged Real signals held over a step: (instance, slot) of their sources.  Inputs
         # that are sampled as a state at the step start carry no hold error of their own.
+        # Midpoint hold: per instance, its Real inputs in feed order as (source, sampled?);
+        # the held ones are averaged over the step.
         held = set()
+        self.held_inputs: list[list[tuple[tuple[int, int], bool]]] = [[] for _ in self.names]
         for c, src in zip(scene.connections, system.connection_sources, strict=True):
+            if src is None:
+                continue
             target = component_class(scene.fmus[c.target[0]].fmu).variable(c.target[1])
-            if src is not None and not target.sampled:
+            if not target.sampled:
                 held.add(src)
+            self.held_inputs[system.index[c.target[0]]].append((src, target.sampled))
         self.signals = sorted(held)
         self.scale = {s: 0.0 for s in self.signals}
-        # Midpoint hold: per instance, which of its Real inputs are held (averaged), and
-        # every Real connection source, whose predictor-corrector difference is the error.
-        self.held_inputs = [
-            [
-                (src, component_class(scene.fmus[name].fmu).variable(var).sampled)
-                for src, var in _real_inputs(system, scene, i)
-            ]
-            for i, name in enumerate(self.names)
-        ]
+        # Every Real connection source: its predictor-corrector difference is the error.
         self.outputs = sorted({s for s in system.connection_sources if s is not None})
         self.out_scale = {s: 0.0 for s in self.outputs}
         self.ratio = 0.0  # error ratio of the last corrected trial
@@ -142,23 +140,15 @@ class RegimeAwareMaster:
         (against the predictor's values at t+h, ``compare``, by default ``predicted``)
         relative to the tolerance: the predictor's error estimate."""
         system = self.system
-        system.set_state(state)  # the step-start outputs are read back as well
-        self.stats.rollbacks += 1
+        self._restore(state)  # the step-start outputs are read back as well
         self.predicted = predicted  # to retake this very step (see _left_values)
         start = before.values
         for i, inputs in enumerate(self.held_inputs):
-            if not inputs:
-                continue
-            values = [
+            reals = [
                 start[s][k] if sampled else 0.5 * (start[s][k] + predicted[s][k])
                 for (s, k), sampled in inputs
             ]
-            system.instances[i].set_real(system.feeds[i].real_refs, values)
-            if system.feeds[i].int_refs:
-                ints = system.ints
-                system.instances[i].set_integer(
-                    system.feeds[i].int_refs, [ints[s][k] for s, k in system.feeds[i].int_sources]
-                )
+            system.feed(i, reals)
         self._step_all(t, h)
         worst, tol = 0.0, self.cfg.tolerance
         values = system.values
@@ -359,8 +349,7 @@ class RegimeAwareMaster:
         crossed = [list(v) for v in self.system.values]  # the predictor across the switch
         h_left = te - t - 0.5 * cfg.event_tolerance
         if h_left > 0.0:
-            self.system.set_state(state)
-            self.stats.rollbacks += 1
+            self._restore(state)
             self.trial(t, h_left)
             predicted = [list(v) for v in self.system.values]
         else:
@@ -395,9 +384,14 @@ class RegimeAwareMaster:
             self.trial(t, h)
         return row
 
-    def _rollback(self, state: list[Any]) -> None:
+    def _restore(self, state: list[Any]) -> None:
+        """Back to the step start (a rollback, not a rejection: the corrector's retake)."""
         self.system.set_state(state)
         self.stats.rollbacks += 1
+
+    def _rollback(self, state: list[Any]) -> None:
+        """Back to the step start after a rejected trial."""
+        self._restore(state)
         self.stats.rejections += 1
 
     def _last_switch(self) -> str:
@@ -405,16 +399,6 @@ class RegimeAwareMaster:
             return "no FMU"
         t, sub, a, b = self.recorder.events[-1]
         return f"FMU {sub!r} ({a} -> {b})"
-
-
-def _real_inputs(system: CoupledSystem, scene: Scene, i: int) -> list[tuple[tuple[int, int], str]]:
-    """Instance i's Real inputs in feed order: (source slot, input variable name)."""
-    name = system.names[i]
-    out = []
-    for c, src in zip(scene.connections, system.connection_sources, strict=True):
-        if src is not None and c.target[0] == name:
-            out.append((src, c.target[1]))
-    return out
 
 
 def run_regime_aware(

@@ -24,7 +24,7 @@ import numpy as np
 
 from components.clock_gear_train import LOSS_POINT, ClockTrainPhysics
 from components.clock_train import M739_TRAIN
-from components.m739_data import LBF, M739, rpm_to_rad_s
+from components.m739_data import M739, rpm_to_rad_s
 from components.verge_escapement import (
     FREE,
     IND_MESH_HI,
@@ -36,7 +36,15 @@ from components.verge_geometry import kinem
 from orchestrator.references import Reference
 from orchestrator.references.m739 import M739Result, _Monolithic, simulate
 from orchestrator.scenario import Scene
-from orchestrator.scenes.m739 import _names, _parameter, _q, _why_not_armed, reference_from
+from orchestrator.scenes.m739 import (
+    _names,
+    _parameter,
+    _q,
+    _why_not_armed,
+    escapement_figure,
+    reference_from,
+    save_figure,
+)
 
 RPM_PER_RAD_S = 60.0 / (2.0 * math.pi)
 #: Rotor angle at arming: the M739's rotor travel, PHICUTD of escape wheel times N31 (= 1/32).
@@ -203,44 +211,17 @@ def reference(scene: Scene) -> Reference:
 def plot(scene: Scene, header: list[str], data: np.ndarray, path: Path) -> None:
     """Verge and escape-wheel motion over the first cycles, with the train's speed ratio and
     mesh efficiencies."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    train, verge = _names(scene)
-    col = {name: data[:, i] for i, name in enumerate(header)}
-    t = col["time"]
-    window = t <= min(t[-1], 2.2e-3)
-    ms = t[window] * 1e3
-    fig, axes = plt.subplots(4, 1, figsize=(9, 10), sharex=True)
-    axes[0].plot(ms, np.degrees(col[f"{train}.phi"][window]), label="escape wheel (cumulative)")
-    axes[0].set_ylabel("angle [deg]")
-    ax2 = axes[0].twinx()
-    ax2.plot(ms, np.degrees(col[f"{verge}.psi"][window]), color="C1", label="verge")
-    ax2.set_ylabel("verge angle [deg]", color="C1")
-    axes[1].plot(ms, col[f"{train}.phi_dot"][window], label="escape wheel")
-    axes[1].plot(ms, col[f"{verge}.psi_dot"][window], label="verge")
-    axes[1].set_ylabel("speed [rad/s]")
-    axes[1].legend(loc="upper right")
-    axes[2].plot(ms, col[f"{verge}.PN"][window] / LBF, label="PN")
-    axes[2].step(ms, col[f"{verge}.regime"][window], where="post", color="grey", label="regime")
-    axes[2].set_ylabel("PN [lb] / regime")
-    axes[2].legend(loc="upper right")
+    train, _ = _names(scene)
+    fig, axes, (ms, col) = escapement_figure(scene, header, data, extra_panels=1)
     if f"{train}.speed_ratio" in col:
-        axes[3].plot(ms, col[f"{train}.speed_ratio"][window], label="speed ratio (wheel/rotor)")
+        axes[3].plot(ms, col[f"{train}.speed_ratio"], label="speed ratio (wheel/rotor)")
         axes[3].set_ylabel("speed ratio [1]")
         if f"{train}.efficiency1" in col:
             ax3 = axes[3].twinx()
             for i, c in ((1, "C2"), (2, "C3")):
-                ax3.plot(
-                    ms, col[f"{train}.efficiency{i}"][window], color=c, label=f"mesh {i} efficiency"
-                )
+                ax3.plot(ms, col[f"{train}.efficiency{i}"], color=c, label=f"mesh {i} efficiency")
             ax3.set_ylabel("point efficiency [1]")
             ax3.legend(loc="lower right")
         axes[3].legend(loc="upper right")
-    axes[3].set_xlabel("time [ms]")
-    fig.suptitle(f"{scene.name}: verge, escape wheel and clock train, first cycles")
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    title = f"{scene.name}: verge, escape wheel and clock train, first cycles"
+    save_figure(fig, title, path)

@@ -137,6 +137,13 @@ def reference_from(result: Any, train: str, verge: str) -> Reference:
 
 def plot(scene: Scene, header: list[str], data: np.ndarray, path: Path) -> None:
     """Verge and escape-wheel motion over the first cycles (about 3 teeth)."""
+    fig, _, _ = escapement_figure(scene, header, data, extra_panels=0)
+    save_figure(fig, f"{scene.name}: verge and escape-wheel motion, first cycles", path)
+
+
+def escapement_figure(scene: Scene, header: list[str], data: np.ndarray, extra_panels: int):
+    """The first 2.2 ms: angles, speeds, and PN with the verge regime, above ``extra_panels``
+    empty panels.  Returns (figure, axes, (ms, columns restricted to the window))."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -146,23 +153,31 @@ def plot(scene: Scene, header: list[str], data: np.ndarray, path: Path) -> None:
     col = {name: data[:, i] for i, name in enumerate(header)}
     t = col["time"]
     window = t <= min(t[-1], 2.2e-3)
-    fig, axes = plt.subplots(3, 1, figsize=(9, 8), sharex=True)
-    ms = t[window] * 1e3
-    axes[0].plot(ms, np.degrees(col[f"{train}.phi"][window]), label="escape wheel (cumulative)")
+    col = {name: values[window] for name, values in col.items()}
+    rows = 3 + extra_panels
+    fig, axes = plt.subplots(rows, 1, figsize=(9, 8 + 2 * extra_panels), sharex=True)
+    ms = col["time"] * 1e3
+    axes[0].plot(ms, np.degrees(col[f"{train}.phi"]), label="escape wheel (cumulative)")
     axes[0].set_ylabel("angle [deg]")
     ax2 = axes[0].twinx()
-    ax2.plot(ms, np.degrees(col[f"{verge}.psi"][window]), color="C1", label="verge")
+    ax2.plot(ms, np.degrees(col[f"{verge}.psi"]), color="C1", label="verge")
     ax2.set_ylabel("verge angle [deg]", color="C1")
-    axes[1].plot(ms, col[f"{train}.phi_dot"][window], label="escape wheel")
-    axes[1].plot(ms, col[f"{verge}.psi_dot"][window], label="verge")
+    axes[1].plot(ms, col[f"{train}.phi_dot"], label="escape wheel")
+    axes[1].plot(ms, col[f"{verge}.psi_dot"], label="verge")
     axes[1].set_ylabel("speed [rad/s]")
     axes[1].legend(loc="upper right")
-    axes[2].plot(ms, col[f"{verge}.PN"][window] / LBF, label="PN")
-    axes[2].step(ms, col[f"{verge}.regime"][window], where="post", color="grey", label="regime")
+    axes[2].plot(ms, col[f"{verge}.PN"] / LBF, label="PN")
+    axes[2].step(ms, col[f"{verge}.regime"], where="post", color="grey", label="regime")
     axes[2].set_ylabel("PN [lb] / regime")
-    axes[2].set_xlabel("time [ms]")
     axes[2].legend(loc="upper right")
-    fig.suptitle(f"{scene.name}: verge and escape-wheel motion, first cycles")
+    axes[-1].set_xlabel("time [ms]")
+    return fig, axes, (ms, col)
+
+
+def save_figure(fig: Any, title: str, path: Path) -> None:
+    import matplotlib.pyplot as plt
+
+    fig.suptitle(title)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
