@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import copy
 import pickle
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any, ClassVar, Literal
 
 Causality = Literal["parameter", "input", "output"]
@@ -45,6 +45,12 @@ class Variable:
     #: a shaft the component follows), not a signal held over the step.  Masters judge the
     #: error of holding inputs on held signals only.
     sampled: bool = False
+    #: Valid range of a parameter (inclusive, SI); None where there is no bound.
+    min: float | None = None
+    max: float | None = None
+    #: Of an output: the inputs it depends on directly within one instant (direct
+    #: feedthrough, recomputed by ``update_outputs``).  Empty: it changes only by stepping.
+    depends_on: tuple[str, ...] = ()
 
 
 class ComponentError(RuntimeError):
@@ -135,3 +141,12 @@ COMMON_OUTPUTS: tuple[Variable, ...] = (
     Variable("stored_energy", "output", "J", 0.0, "kinetic + potential energy held"),
     Variable("dissipated_work", "output", "J", 0.0, "work dissipated since start"),
 )
+
+
+def common_outputs(**depends_on: tuple[str, ...]) -> tuple[Variable, ...]:
+    """COMMON_OUTPUTS with the direct feedthrough a component gives some of them, e.g.
+    ``common_outputs(stored_energy=("phi_in",))`` for a spring stretched by an input."""
+    unknown = sorted(set(depends_on) - {v.name for v in COMMON_OUTPUTS})
+    if unknown:
+        raise KeyError(f"not common outputs: {unknown}")
+    return tuple(replace(v, depends_on=depends_on.get(v.name, ())) for v in COMMON_OUTPUTS)

@@ -14,8 +14,8 @@ from __future__ import annotations
 
 import math
 
-from components.base import COMMON_OUTPUTS, Component, ComponentError, Variable
-from components.press_feed_data import APP_H_J_O5, LBF_IN, ROLLER_RADIUS
+from .base import COMMON_OUTPUTS, Component, ComponentError, Variable
+from .press_feed_data import APP_H_J_O5, LBF_IN, ROLLER_RADIUS
 
 REGIME_STICK = 0
 REGIME_SLIP_FORWARD = 1
@@ -64,20 +64,38 @@ class BrakeLoad(Component):
     PORTS = {"shaft": {"angle": "angle", "speed": "speed", "torque": "torque"}}
 
     VARIABLES = (
-        Variable("j", "parameter", "kg.m2", APP_H_J_O5, "shaft + referred strip inertia J_o5"),
-        Variable("brake_torque", "parameter", "N.m", 160.0 * LBF_IN, "friction torque T_b"),
-        Variable("roller_radius", "parameter", "m", ROLLER_RADIUS, "feed roller radius"),
+        Variable(
+            "j", "parameter", "kg.m2", APP_H_J_O5, "shaft + referred strip inertia J_o5", min=0.0
+        ),
+        Variable(
+            "brake_torque", "parameter", "N.m", 160.0 * LBF_IN, "friction torque T_b", min=0.0
+        ),
+        Variable("roller_radius", "parameter", "m", ROLLER_RADIUS, "feed roller radius", min=0.0),
         Variable("angle0", "parameter", "rad", 0.0, "initial angle (forward positive)"),
         Variable("speed0", "parameter", "rad/s", 0.0, "initial speed"),
         Variable("torque", "input", "N.m", 0.0, "torque from the clutch (forward positive)"),
         Variable("angle", "output", "rad", 0.0, "inner race / roller angle, forward positive"),
         Variable("speed", "output", "rad/s", 0.0, "roller speed; zero while slipping = stop"),
         Variable("feed_length", "output", "m", 0.0, "strip advance since start"),
-        Variable("breakaway", "output", "N.m", 0.0, "|torque| - T_b; zero while stuck = slip"),
+        Variable(
+            "breakaway",
+            "output",
+            "N.m",
+            0.0,
+            "|torque| - T_b; zero while stuck = slip",
+            depends_on=("torque",),
+        ),
         Variable("input_work", "output", "J", 0.0, "work done by the input torque"),
         Variable("event_time", "output", "s", -1.0, "time of the last stop (slip -> stick)"),
         Variable("t_event", "output", "s", -1.0, "time of the last regime change"),
-        Variable("ind_brake", "output", "1", 0.0, "|T| - T_b if stuck, speed if slipping"),
+        Variable(
+            "ind_brake",
+            "output",
+            "1",
+            0.0,
+            "|T| - T_b if stuck, speed if slipping",
+            depends_on=("torque",),
+        ),
         *COMMON_OUTPUTS,
     )
 

@@ -69,15 +69,17 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from components.base import COMMON_OUTPUTS, ComponentError, Variable
-from components.clock_train import M739_TRAIN, ClockMesh, ClockTrain
-from components.gear_train import (
+from .base import ComponentError, Variable, common_outputs
+from .clock_train import M739_TRAIN, ClockMesh, ClockTrain
+from .gear_train import (
     ESCAPE_WHEEL_PORT,
     ESCAPE_WHEEL_VARIABLES,
+    IMPACT_INPUTS,
+    WHEEL_INPUTS,
     TrainComponent,
     TrainLoadModel,
 )
-from components.m739_data import M739, M739Data
+from .m739_data import M739, M739Data
 
 LOSS_NONE = 0
 LOSS_POINT = 1
@@ -490,30 +492,79 @@ class ClockGearTrain(TrainComponent):
     PORTS = {"escape_wheel": ESCAPE_WHEEL_PORT}
 
     VARIABLES = (
-        Variable("mu", "parameter", "1", M739.mu, "Coulomb friction, mesh contacts and pivots"),
-        Variable("spin", "parameter", "rad/s", M739.omega, "fuze spin rate omega"),
         Variable(
-            "loss_model", "parameter", "1", LOSS_POINT, "mesh losses: 0 none, 1 point, 2 cycle"
+            "mu", "parameter", "1", M739.mu, "Coulomb friction, mesh contacts and pivots", min=0.0
         ),
-        Variable("pivot_loads", "parameter", "1", 1, "1: pivot friction of the centrifugal loads"),
+        # The model takes |omega| (spin in either sense gives the same motion): spin >= 0.
+        Variable("spin", "parameter", "rad/s", M739.omega, "fuze spin rate omega", min=0.0),
+        Variable(
+            "loss_model",
+            "parameter",
+            "1",
+            LOSS_POINT,
+            "mesh losses: 0 none, 1 point, 2 cycle",
+            min=LOSS_NONE,
+            max=LOSS_CYCLE,
+        ),
+        Variable(
+            "pivot_loads",
+            "parameter",
+            "1",
+            1,
+            "1: pivot friction of the centrifugal loads",
+            min=0.0,
+            max=1.0,
+        ),
         Variable(
             "mesh_phase", "parameter", "rad", 0.0, "escape-wheel angle of the train at phi = 0"
         ),
         Variable("phi_start", "parameter", "rad", 0.0, "initial cumulative escape-wheel angle"),
         Variable("phi_dot_start", "parameter", "rad/s", 0.0, "initial escape-wheel speed"),
-        Variable("h_max", "parameter", "s", 1.0e-6, "largest internal RK4 step"),
+        Variable("h_max", "parameter", "s", 1.0e-6, "largest internal RK4 step", min=0.0),
         *ESCAPE_WHEEL_VARIABLES,
         Variable(
             "J_load", "input", "kg.m2", 0.0, "inertia riding on the wheel (handover)", sampled=True
         ),
-        Variable("F12", "output", "N", 0.0, "mesh-1 normal force (any regime)"),
-        Variable("F23", "output", "N", 0.0, "mesh-2 normal force (any regime)"),
-        Variable("FF12", "output", "N", 0.0, "mesh-1 force when unloaded (T_esc = 0), else 0"),
-        Variable("FF23", "output", "N", 0.0, "mesh-2 force when unloaded (T_esc = 0), else 0"),
+        Variable(
+            "F12", "output", "N", 0.0, "mesh-1 normal force (any regime)", depends_on=WHEEL_INPUTS
+        ),
+        Variable(
+            "F23", "output", "N", 0.0, "mesh-2 normal force (any regime)", depends_on=WHEEL_INPUTS
+        ),
+        Variable(
+            "FF12",
+            "output",
+            "N",
+            0.0,
+            "mesh-1 force when unloaded (T_esc = 0), else 0",
+            depends_on=WHEEL_INPUTS,
+        ),
+        Variable(
+            "FF23",
+            "output",
+            "N",
+            0.0,
+            "mesh-2 force when unloaded (T_esc = 0), else 0",
+            depends_on=WHEEL_INPUTS,
+        ),
         Variable("rotor_angle", "output", "rad", M739.phi1c, "rotor angle Phi"),
         Variable("speed_ratio", "output", "1", 32.0, "escape-wheel speed per rotor speed"),
-        Variable("efficiency1", "output", "1", 1.0, "mesh-1 point efficiency in force"),
-        Variable("efficiency2", "output", "1", 1.0, "mesh-2 point efficiency in force"),
+        Variable(
+            "efficiency1",
+            "output",
+            "1",
+            1.0,
+            "mesh-1 point efficiency in force",
+            depends_on=WHEEL_INPUTS,
+        ),
+        Variable(
+            "efficiency2",
+            "output",
+            "1",
+            1.0,
+            "mesh-2 point efficiency in force",
+            depends_on=WHEEL_INPUTS,
+        ),
         Variable(
             "phase1", "output", "1", 0, "mesh-1 phase: 0 round-on-round, 1 on flank", "Integer"
         ),
@@ -523,11 +574,25 @@ class ClockGearTrain(TrainComponent):
         Variable("pair1", "output", "1", 0, "mesh-1 tooth pair index", "Integer"),
         Variable("pair2", "output", "1", 0, "mesh-2 tooth pair index", "Integer"),
         Variable("handovers", "output", "1", 0, "tooth-pair handovers so far", "Integer"),
-        Variable("ind_mesh1", "output", "rad", 0.0, "mesh 1: pinion angle to the next phase bound"),
-        Variable("ind_mesh2", "output", "rad", 0.0, "mesh 2: pinion angle to the next phase bound"),
+        Variable(
+            "ind_mesh1",
+            "output",
+            "rad",
+            0.0,
+            "mesh 1: pinion angle to the next phase bound",
+            depends_on=WHEEL_INPUTS,
+        ),
+        Variable(
+            "ind_mesh2",
+            "output",
+            "rad",
+            0.0,
+            "mesh 2: pinion angle to the next phase bound",
+            depends_on=WHEEL_INPUTS,
+        ),
         Variable("t_event", "output", "s", -1.0, "first internal switch of the last such step"),
         Variable("external_work", "output", "J", 0.0, "work of the spin on the rotor"),
-        *COMMON_OUTPUTS,
+        *common_outputs(regime=WHEEL_INPUTS, stored_energy=IMPACT_INPUTS),
     )
 
     def initialize(self, t0: float) -> None:

@@ -42,8 +42,8 @@ from typing import Any
 
 import numpy as np
 
-from components.base import COMMON_OUTPUTS, Component, ComponentError, Variable
-from components.detached_lever_data import (
+from .base import COMMON_OUTPUTS, Component, ComponentError, Variable
+from .detached_lever_data import (
     BALANCE_INERTIA,
     LIFT_ANGLE,
     OVERBANK,
@@ -107,23 +107,87 @@ class DetachedLever(Component):
     REGIME_NAMES = REGIME_NAMES
 
     VARIABLES = (
-        Variable("inertia", "parameter", "kg.m2", _I0, "balance polar inertia I"),
-        Variable("stiffness", "parameter", "N.m/rad", _I0 * _WE.omega0**2, "hairspring rate K0"),
-        Variable("viscous", "parameter", "N.m.s/rad", _I0 * _WE.c, "viscous coefficient C.I"),
-        Variable("coulomb", "parameter", "N.m", _I0 * _WE.r, "kinetic friction torque R.I"),
-        Variable("alpha", "parameter", "rad", _WE.alpha, "impulse before dead point, moving -"),
-        Variable("beta", "parameter", "rad", _WE.alpha, "impulse after dead point, moving -"),
-        Variable("gamma", "parameter", "rad", _WE.alpha, "impulse before dead point, moving +"),
-        Variable("mu", "parameter", "rad", _WE.alpha, "impulse after dead point, moving +"),
-        Variable("epsilon", "parameter", "rad", _WE.epsilon, "start of unlock, moving -"),
-        Variable("sigma", "parameter", "rad", _WE.epsilon, "start of unlock, moving +"),
-        Variable("impulse_ratio", "parameter", "1", 1.0, "balance torque per drive torque"),
+        Variable("inertia", "parameter", "kg.m2", _I0, "balance polar inertia I", min=0.0),
+        Variable(
+            "stiffness",
+            "parameter",
+            "N.m/rad",
+            _I0 * _WE.omega0**2,
+            "hairspring rate K0",
+            min=0.0,
+        ),
+        Variable(
+            "viscous", "parameter", "N.m.s/rad", _I0 * _WE.c, "viscous coefficient C.I", min=0.0
+        ),
+        Variable(
+            "coulomb", "parameter", "N.m", _I0 * _WE.r, "kinetic friction torque R.I", min=0.0
+        ),
+        # Window angles: within a quarter turn of the dead point (the impulse pin leaves the
+        # fork long before; the phase-scheduled model requires it).
+        Variable(
+            "alpha",
+            "parameter",
+            "rad",
+            _WE.alpha,
+            "impulse before dead point, moving -",
+            min=0.0,
+            max=_HALF_PI,
+        ),
+        Variable(
+            "beta",
+            "parameter",
+            "rad",
+            _WE.alpha,
+            "impulse after dead point, moving -",
+            min=0.0,
+            max=_HALF_PI,
+        ),
+        Variable(
+            "gamma",
+            "parameter",
+            "rad",
+            _WE.alpha,
+            "impulse before dead point, moving +",
+            min=0.0,
+            max=_HALF_PI,
+        ),
+        Variable(
+            "mu",
+            "parameter",
+            "rad",
+            _WE.alpha,
+            "impulse after dead point, moving +",
+            min=0.0,
+            max=_HALF_PI,
+        ),
+        Variable(
+            "epsilon",
+            "parameter",
+            "rad",
+            _WE.epsilon,
+            "start of unlock, moving -",
+            min=0.0,
+            max=_HALF_PI,
+        ),
+        Variable(
+            "sigma",
+            "parameter",
+            "rad",
+            _WE.epsilon,
+            "start of unlock, moving +",
+            min=0.0,
+            max=_HALF_PI,
+        ),
+        Variable(
+            "impulse_ratio", "parameter", "1", 1.0, "balance torque per drive torque", min=0.0
+        ),
         Variable(
             "unlock_ratio",
             "parameter",
             "1",
             _WE.x_unlock / _WE.x_impulse,
             "resisting balance torque per drive torque while unlocking",
+            min=0.0,
         ),
         Variable(
             "switching_mode",
@@ -132,6 +196,8 @@ class DetachedLever(Component):
             PHASE_SCHEDULED,
             "0 phase-scheduled (thesis), 1 angle-switched (physical)",
             "Integer",
+            min=PHASE_SCHEDULED,
+            max=ANGLE_SWITCHED,
         ),
         Variable("theta_start", "parameter", "rad", _WE.theta0, "initial balance angle"),
         Variable(
@@ -140,6 +206,7 @@ class DetachedLever(Component):
             "rad",
             OVERBANK,
             "amplitude at which the impulse pin would strike the fork from behind",
+            min=0.0,
         ),
         Variable("omega_start", "parameter", "rad/s", 0.0, "initial balance speed"),
         Variable(

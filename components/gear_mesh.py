@@ -51,11 +51,11 @@ from functools import cache
 
 import numpy as np
 
-from components.base import COMMON_OUTPUTS, Component, ComponentError, Variable
-from components.clock_train import M739_MESH1, M739_MESH2
-from components.clock_train import ClockMesh as TrainClockMesh
-from components.m739_data import M739
-from components.mesh_efficiency import (
+from .base import COMMON_OUTPUTS, Component, ComponentError, Variable
+from .clock_train import M739_MESH1, M739_MESH2
+from .clock_train import ClockMesh as TrainClockMesh
+from .m739_data import M739
+from .mesh_efficiency import (
     LEGACY_PI,
     InvoluteGeometry,
     involute_efficiency_at,
@@ -67,7 +67,7 @@ from components.mesh_efficiency import (
     train_mesh_efficiency,
     train_mesh_window,
 )
-from components.mesh_efficiency_data import ALFIN_ANOMALY_TABLES, INVOLUTE_MESHES, PRINTED_RUNS
+from .mesh_efficiency_data import ALFIN_ANOMALY_TABLES, INVOLUTE_MESHES, PRINTED_RUNS
 
 MODEL_IDEAL, MODEL_INVOLUTE, MODEL_CLOCK = 0, 1, 2
 MODEL_NAMES = {MODEL_IDEAL: "ideal", MODEL_INVOLUTE: "involute", MODEL_CLOCK: "clock"}
@@ -306,28 +306,31 @@ class GearMesh(Component):
         Variable(
             "model", "parameter", "1", MODEL_INVOLUTE,
             "mesh model: 0 ideal, 1 involute mesh of source 001, 2 clock mesh (derived)",
-            "Integer",
+            "Integer", min=MODEL_IDEAL, max=MODEL_CLOCK,
         ),
         Variable(
             "mesh", "parameter", "1", 2,
             "involute mesh k = 1..9: Table k + 4 of source 001 (2: the Appendix E mesh)",
-            "Integer",
+            "Integer", min=1, max=9,
         ),
         Variable(
             "clock_mesh", "parameter", "1", 1,
             "clock mesh 1 or 2 of the M739-like two-pass train (M739_MESH1 / M739_MESH2)",
-            "Integer",
+            "Integer", min=1, max=2,
         ),
         Variable(
             "printed_run", "parameter", "1", 0,
             "1: as the 1981 program ran (pi = 3.14159, printed ALFIN of Tables 15, 16, 18, 21)",
-            "Integer",
+            "Integer", min=0, max=1,
         ),
-        Variable("mu", "parameter", "1", 0.1, "Coulomb friction at the teeth and both pivots"),
-        Variable("speed", "parameter", "rad/s", 10.0, "set speed of the driver (> 0)"),
+        Variable(
+            "mu", "parameter", "1", 0.1, "Coulomb friction at the teeth and both pivots", min=0.0
+        ),
+        Variable("speed", "parameter", "rad/s", 10.0, "set speed of the driver (> 0)", min=0.0),
         Variable(
             "phase0", "parameter", "1", 0.0,
             "start within the mesh cycle, as a fraction of it (0: a new pair enters)",
+            min=0.0, max=1.0,
         ),
         Variable(
             "load_torque", "input", "N.m", 0.1,
@@ -339,9 +342,18 @@ class GearMesh(Component):
         Variable("driven_speed", "output", "rad/s", 0.0, "driven member speed"),
         Variable("speed_ratio", "output", "1", 0.0, "instantaneous speed ratio driven/driver"),
         Variable("efficiency", "output", "1", 1.0, "point (instantaneous) efficiency"),
-        Variable("driver_torque", "output", "N.m", 0.0, "torque driving the driver"),
-        Variable("input_power", "output", "W", 0.0, "power into the driver"),
-        Variable("output_power", "output", "W", 0.0, "power delivered to the load"),
+        Variable(
+            "driver_torque", "output", "N.m", 0.0, "torque driving the driver",
+            depends_on=("load_torque",),
+        ),
+        Variable(
+            "input_power", "output", "W", 0.0, "power into the driver",
+            depends_on=("load_torque",),
+        ),
+        Variable(
+            "output_power", "output", "W", 0.0, "power delivered to the load",
+            depends_on=("load_torque",),
+        ),
         Variable("input_work", "output", "J", 0.0, "work done on the driver since the start"),
         Variable("output_work", "output", "J", 0.0, "work delivered to the load since the start"),
         Variable("external_work", "output", "J", 0.0, "work brought in by the drive"),

@@ -38,9 +38,9 @@ import math
 from collections.abc import Callable, Sequence
 from typing import Any, Protocol
 
-from components.base import COMMON_OUTPUTS, Component, ComponentError, Variable
-from components.m739_data import M739, M739Data
-from components.verge_geometry import fuze_angles
+from .base import Component, ComponentError, Variable, common_outputs
+from .m739_data import M739, M739Data
+from .verge_geometry import fuze_angles
 
 INDEXING_PHYSICAL = 0
 INDEXING_AS_RUN = 1
@@ -561,6 +561,12 @@ ESCAPE_WHEEL_PORT = {
     "load_inertia": "J_esc",
 }
 
+#: Direct feedthrough of a train: an impact sets the wheel speed at once, and at rest the
+#: held escapement load decides start, direction or stick, so whatever follows the wheel's
+#: speed, direction or acceleration depends on these inputs within one instant.
+IMPACT_INPUTS = ("impact_count", "phi_dot_impact")
+WHEEL_INPUTS = ("T_esc", "T_esc_static", "J_esc", *IMPACT_INPUTS)
+
 #: The train side of that port.  Impact inputs are events taken once, not signals held
 #: over the step.
 ESCAPE_WHEEL_VARIABLES = (
@@ -592,10 +598,26 @@ ESCAPE_WHEEL_VARIABLES = (
         "phi_dot_impact", "input", "rad/s", 0.0, "escape-wheel speed after impact", sampled=True
     ),
     Variable("phi", "output", "rad", 0.0, "cumulative escape-wheel angle"),
-    Variable("phi_dot", "output", "rad/s", 0.0, "escape-wheel speed"),
-    Variable("phi_ddot", "output", "rad/s2", 0.0, "escape-wheel acceleration"),
-    Variable("J_ref", "output", "kg.m2", 0.0, "effective inertia at the escape wheel"),
-    Variable("T_ref", "output", "N.m", 0.0, "net train torque at the escape wheel"),
+    Variable("phi_dot", "output", "rad/s", 0.0, "escape-wheel speed", depends_on=IMPACT_INPUTS),
+    Variable(
+        "phi_ddot", "output", "rad/s2", 0.0, "escape-wheel acceleration", depends_on=WHEEL_INPUTS
+    ),
+    Variable(
+        "J_ref",
+        "output",
+        "kg.m2",
+        0.0,
+        "effective inertia at the escape wheel",
+        depends_on=WHEEL_INPUTS,
+    ),
+    Variable(
+        "T_ref",
+        "output",
+        "N.m",
+        0.0,
+        "net train torque at the escape wheel",
+        depends_on=WHEEL_INPUTS,
+    ),
     Variable("c_load", "output", "1", 1.0, "factor of T_esc in J_ref phi_dd = T_ref + c T_esc"),
     Variable("J_stot", "output", "kg.m2", 0.0, "frictionless reflected inertia (impacts, B213)"),
 )
@@ -697,24 +719,78 @@ class GearTrain(TrainComponent):
     PORTS = {"escape_wheel": ESCAPE_WHEEL_PORT}
 
     VARIABLES = (
-        Variable("mu", "parameter", "1", M739.mu, "Coulomb friction, teeth and train pivots"),
-        Variable("spin", "parameter", "rad/s", M739.omega, "fuze spin rate omega"),
-        Variable("indexing", "parameter", "1", INDEXING_PHYSICAL, "0 physical, 1 as-run"),
+        Variable(
+            "mu", "parameter", "1", M739.mu, "Coulomb friction, teeth and train pivots", min=0.0
+        ),
+        # The model takes |omega| (spin in either sense gives the same motion): spin >= 0.
+        Variable("spin", "parameter", "rad/s", M739.omega, "fuze spin rate omega", min=0.0),
+        Variable(
+            "indexing",
+            "parameter",
+            "1",
+            INDEXING_PHYSICAL,
+            "0 physical, 1 as-run",
+            min=INDEXING_PHYSICAL,
+            max=INDEXING_AS_RUN,
+        ),
         Variable("phi_start", "parameter", "rad", 0.0, "initial cumulative escape-wheel angle"),
         Variable("phi_dot_start", "parameter", "rad/s", 0.0, "initial escape-wheel speed"),
-        Variable("h_max", "parameter", "s", 1.0e-6, "largest internal RK4 step"),
+        Variable("h_max", "parameter", "s", 1.0e-6, "largest internal RK4 step", min=0.0),
         *ESCAPE_WHEEL_VARIABLES,
-        Variable("F12", "output", "N", 0.0, "mesh-1 contact force (any regime)"),
-        Variable("F23", "output", "N", 0.0, "mesh-2 contact force (any regime)"),
-        Variable("FF12", "output", "N", 0.0, "mesh-1 force when unloaded (T_esc = 0), else 0"),
-        Variable("FF23", "output", "N", 0.0, "mesh-2 force when unloaded (T_esc = 0), else 0"),
+        Variable(
+            "F12", "output", "N", 0.0, "mesh-1 contact force (any regime)", depends_on=WHEEL_INPUTS
+        ),
+        Variable(
+            "F23", "output", "N", 0.0, "mesh-2 contact force (any regime)", depends_on=WHEEL_INPUTS
+        ),
+        Variable(
+            "FF12",
+            "output",
+            "N",
+            0.0,
+            "mesh-1 force when unloaded (T_esc = 0), else 0",
+            depends_on=WHEEL_INPUTS,
+        ),
+        Variable(
+            "FF23",
+            "output",
+            "N",
+            0.0,
+            "mesh-2 force when unloaded (T_esc = 0), else 0",
+            depends_on=WHEEL_INPUTS,
+        ),
         Variable("rotor_angle", "output", "rad", M739.phi1c, "rotor angle Phi"),
-        Variable("s1", "output", "1", 1, "mesh-1 sign, +1 approach, -1 recess", "Integer"),
-        Variable("s2", "output", "1", 1, "mesh-2 sign, +1 approach, -1 recess", "Integer"),
-        Variable("indicator_mesh", "output", "rad", 0.0, "distance to the next mesh event"),
+        # The mesh signs follow the direction of motion where the wheel rests on a tooth
+        # change or pitch point, as at the M739 start (J1 = J2 = 0 at phi = 0).
+        Variable(
+            "s1",
+            "output",
+            "1",
+            1,
+            "mesh-1 sign, +1 approach, -1 recess",
+            "Integer",
+            depends_on=WHEEL_INPUTS,
+        ),
+        Variable(
+            "s2",
+            "output",
+            "1",
+            1,
+            "mesh-2 sign, +1 approach, -1 recess",
+            "Integer",
+            depends_on=WHEEL_INPUTS,
+        ),
+        Variable(
+            "indicator_mesh",
+            "output",
+            "rad",
+            0.0,
+            "distance to the next mesh event",
+            depends_on=WHEEL_INPUTS,
+        ),
         Variable("t_event", "output", "s", -1.0, "time of the last reversal or stick"),
         Variable("external_work", "output", "J", 0.0, "work of the spin on the rotor"),
-        *COMMON_OUTPUTS,
+        *common_outputs(regime=WHEEL_INPUTS, stored_energy=IMPACT_INPUTS),
     )
 
     def initialize(self, t0: float) -> None:

@@ -32,8 +32,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import brentq
 
-from components.clock_train import ClockMesh as TrainClockMesh
-from components.mesh_efficiency_data import INCH, ClockMesh, InvoluteMesh
+from .clock_train import ClockMesh as TrainClockMesh
+from .mesh_efficiency_data import INCH, ClockMesh, InvoluteMesh
 
 #: The programs' truncated pi and degree factor (note §4); only for regression to the printout.
 LEGACY_PI = 3.14159

@@ -9,14 +9,14 @@ from __future__ import annotations
 
 import math
 
-from components.base import COMMON_OUTPUTS, Component, ComponentError, Variable
+from .base import COMMON_OUTPUTS, Component, ComponentError, Variable, common_outputs
 
 
 class Inertia(Component):
     """A rigid body on a frictionless pivot, driven by an input torque."""
 
     VARIABLES = (
-        Variable("J", "parameter", "kg.m2", 1.0e-3, "moment of inertia"),
+        Variable("J", "parameter", "kg.m2", 1.0e-3, "moment of inertia", min=0.0),
         Variable("phi0", "parameter", "rad", 0.0, "initial angle"),
         Variable("w0", "parameter", "rad/s", 0.0, "initial angular velocity"),
         Variable("tau", "input", "N.m", 0.0, "torque applied to the body"),
@@ -54,18 +54,22 @@ class SpringDamperInertia(Component):
     """
 
     VARIABLES = (
-        Variable("J", "parameter", "kg.m2", 1.0e-3, "moment of inertia"),
-        Variable("k", "parameter", "N.m/rad", 10.0, "torsional stiffness"),
-        Variable("d", "parameter", "N.m.s/rad", 0.01, "torsional damping"),
-        Variable("max_twist", "parameter", "rad", 1.0e30, "twist at which the coupling breaks"),
+        Variable("J", "parameter", "kg.m2", 1.0e-3, "moment of inertia", min=0.0),
+        Variable("k", "parameter", "N.m/rad", 10.0, "torsional stiffness", min=0.0),
+        Variable("d", "parameter", "N.m.s/rad", 0.01, "torsional damping", min=0.0),
+        Variable(
+            "max_twist", "parameter", "rad", 1.0e30, "twist at which the coupling breaks", min=0.0
+        ),
         Variable("phi0", "parameter", "rad", 0.0, "initial angle"),
         Variable("w0", "parameter", "rad/s", 0.0, "initial angular velocity"),
         Variable("phi_in", "input", "rad", 0.0, "angle of the other body's port", sampled=True),
         Variable("w_in", "input", "rad/s", 0.0, "angular velocity of the other body's port"),
         Variable("phi", "output", "rad", 0.0, "angle"),
         Variable("w", "output", "rad/s", 0.0, "angular velocity"),
-        Variable("tau", "output", "N.m", 0.0, "torque on the other body"),
-        *COMMON_OUTPUTS,
+        Variable(
+            "tau", "output", "N.m", 0.0, "torque on the other body", depends_on=("phi_in", "w_in")
+        ),
+        *common_outputs(stored_energy=("phi_in",)),
     )
     PORTS = {"coupling": {"angle": "phi_in", "speed": "w_in", "torque": "tau"}}
 

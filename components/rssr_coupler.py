@@ -21,8 +21,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from components.base import COMMON_OUTPUTS, Component, ComponentError, Variable
-from components.press_feed_data import (
+from .base import COMMON_OUTPUTS, Component, ComponentError, Variable
+from .press_feed_data import (
     APP_H_FOURIER,
     COUPLER_DAMPING_FACTOR,
     COUPLER_STANDARD,
@@ -33,7 +33,7 @@ from components.press_feed_data import (
     BentCoupler,
     RSSRLinkage,
 )
-from components.rssr_kinematics import ExactRSSR, FourierRocker, rocker_extremes
+from .rssr_kinematics import ExactRSSR, FourierRocker, rocker_extremes
 
 REGIME_RETURN = 0  # rocker moving back (theta4 decreasing)
 REGIME_FORWARD = 1  # rocker on the feed stroke (theta4 increasing)
@@ -206,33 +206,56 @@ class CrankCouplerDrive(Component):
     PORTS = {"rocker": {"angle": "angle", "speed": "speed", "torque": "torque"}}
 
     VARIABLES = (
-        Variable("rpm", "parameter", "1", 200.0, "crank speed [rev/min] (if crank_speed = 0)"),
-        Variable("crank_speed", "parameter", "rad/s", 0.0, "crank speed; 0: take rpm"),
+        Variable(
+            "rpm", "parameter", "1", 200.0, "crank speed [rev/min] (if crank_speed = 0)", min=0.0
+        ),
+        Variable("crank_speed", "parameter", "rad/s", 0.0, "crank speed; 0: take rpm", min=0.0),
         Variable("phi1_0", "parameter", "rad", 0.0, "crank angle at t0 (if start_at_max = 0)"),
-        Variable("start_at_max", "parameter", "1", 1.0, "1: start at the rigid rocker maximum"),
-        Variable("a1", "parameter", "m", _T1.a1, "crank length"),
-        Variable("a3", "parameter", "m", _T1.a3, "coupler chord AC"),
-        Variable("a4", "parameter", "m", _T1.a4, "rocker length"),
+        Variable(
+            "start_at_max",
+            "parameter",
+            "1",
+            1.0,
+            "1: start at the rigid rocker maximum",
+            min=0.0,
+            max=1.0,
+        ),
+        Variable("a1", "parameter", "m", _T1.a1, "crank length", min=0.0),
+        Variable("a3", "parameter", "m", _T1.a3, "coupler chord AC", min=0.0),
+        Variable("a4", "parameter", "m", _T1.a4, "rocker length", min=0.0),
+        # Frame offsets are signed distances along the joint axes (Hartenberg-Denavit).
         Variable("s1", "parameter", "m", _T1.s1, "frame offset s1"),
         Variable("s2", "parameter", "m", _T1.s2, "frame offset s2"),
         Variable("s3", "parameter", "m", _T1.s3, "frame offset s3"),
-        Variable("alpha", "parameter", "rad", _C.alpha, "coupler half bend angle"),
-        Variable("L", "parameter", "m", _C.length, "coupler section length"),
-        Variable("d_outer", "parameter", "m", _C.d_outer, "coupler tube outer diameter"),
-        Variable("d_inner", "parameter", "m", _C.d_inner, "coupler tube inner diameter"),
-        Variable("youngs", "parameter", "Pa", _C.youngs, "coupler Young's modulus"),
-        Variable("density", "parameter", "kg/m3", _C.density, "coupler density"),
-        Variable("c_co", "parameter", "N.s/m2", _C.c_co, "coupler damping per unit length"),
-        Variable("p1", "parameter", "m", _C.p1, "mean of P1 (B.17)"),
-        Variable("gauge_x1", "parameter", "m", _C.gauge_x1, "strain gauge position from A"),
-        Variable("lumped_mass", "parameter", "kg", 0.0, "mass clamped at B (App. G)"),
-        Variable("j_o4", "parameter", "kg.m2", J_O4, "rocker + clutch input inertia"),
+        Variable(
+            "alpha",
+            "parameter",
+            "rad",
+            _C.alpha,
+            "coupler half bend angle",
+            min=0.0,
+            max=0.5 * math.pi,
+        ),
+        Variable("L", "parameter", "m", _C.length, "coupler section length", min=0.0),
+        Variable("d_outer", "parameter", "m", _C.d_outer, "coupler tube outer diameter", min=0.0),
+        Variable("d_inner", "parameter", "m", _C.d_inner, "coupler tube inner diameter", min=0.0),
+        Variable("youngs", "parameter", "Pa", _C.youngs, "coupler Young's modulus", min=0.0),
+        Variable("density", "parameter", "kg/m3", _C.density, "coupler density", min=0.0),
+        Variable(
+            "c_co", "parameter", "N.s/m2", _C.c_co, "coupler damping per unit length", min=0.0
+        ),
+        Variable("p1", "parameter", "m", _C.p1, "mean of P1 (B.17)", min=0.0),
+        Variable(
+            "gauge_x1", "parameter", "m", _C.gauge_x1, "strain gauge position from A", min=0.0
+        ),
+        Variable("lumped_mass", "parameter", "kg", 0.0, "mass clamped at B (App. G)", min=0.0),
+        Variable("j_o4", "parameter", "kg.m2", J_O4, "rocker + clutch input inertia", min=0.0),
         Variable("f1_a0", "parameter", "m2", APP_H_FOURIER.f1[0], "F1/phi1dot^2 constant a10"),
         Variable("f1_a1", "parameter", "m2", APP_H_FOURIER.f1[1], "F1/phi1dot^2 cos term a11"),
         Variable("f1_b1", "parameter", "m2", APP_H_FOURIER.f1[2], "F1/phi1dot^2 sin term b11"),
-        Variable("f2_const", "parameter", "rad/m", 0.0, "constant F2 (0: F2(phi1) exact)"),
-        Variable("rigid", "parameter", "1", 0.0, "1: rigid coupler (q = 0)"),
-        Variable("max_step", "parameter", "s", 1.0e-4, "largest internal RK4 step"),
+        Variable("f2_const", "parameter", "rad/m", 0.0, "constant F2 (0: F2(phi1) exact)", min=0.0),
+        Variable("rigid", "parameter", "1", 0.0, "1: rigid coupler (q = 0)", min=0.0, max=1.0),
+        Variable("max_step", "parameter", "s", 1.0e-4, "largest internal RK4 step", min=0.0),
         Variable("torque", "input", "N.m", 0.0, "torque transmitted by the clutch (>= 0)"),
         Variable("phi1", "output", "rad", 0.0, "crank angle (absolute, unwrapped)"),
         Variable("angle", "output", "rad", 0.0, "rocker / outer race angle, forward positive"),

@@ -14,7 +14,7 @@ import math
 
 import numpy as np
 
-from components.press_feed_data import RSSRLinkage
+from .press_feed_data import RSSRLinkage
 
 Kinematics = tuple[float, float, float, float, float, float]
 

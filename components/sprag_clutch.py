@@ -20,8 +20,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from components.base import COMMON_OUTPUTS, Component, ComponentError, Variable
-from components.press_feed_data import C_NL, K_SP, N_DAMP, TABLE4, SpragGeometry
+from .base import Component, ComponentError, Variable, common_outputs
+from .press_feed_data import C_NL, K_SP, N_DAMP, TABLE4, SpragGeometry
 
 REGIME_OVERRUN = 0
 REGIME_ENGAGED = 1
@@ -214,6 +214,10 @@ def windup_integral(ratio: float, n: float = N_DAMP) -> float:
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(8)
 _GL_X, _GL_W = tuple(0.5 * (_GL_X + 1.0)), tuple(0.5 * _GL_W)
 _S = TABLE4
+# Direct feedthrough: the windup follows the race angles, its rate the race speeds.
+_RACE_ANGLES = ("angle_outer", "angle_inner")
+_RACE_SPEEDS = ("speed_outer", "speed_inner")
+_RACE_MOTION = _RACE_ANGLES + _RACE_SPEEDS
 
 
 class SpragClutch(Component):
@@ -241,35 +245,111 @@ class SpragClutch(Component):
     }
 
     VARIABLES = (
-        Variable("model", "parameter", "1", MODEL_LUMPED, "0: lumped K; 1: two-point Hertz"),
-        Variable("k", "parameter", "N.m", K_SP, "lumped stiffness K_sp [N.m/rad^1.5] (model 0)"),
-        Variable("c_lin", "parameter", "N.m.s/rad", 0.0, "linear damping C_sp (Part I)"),
-        Variable("c_nl", "parameter", "N.m.s", C_NL, "nonlinear damping C_nl [N.m.s/rad^1.25]"),
-        Variable("n_damp", "parameter", "1", N_DAMP, "damping exponent n"),
-        Variable("engaged0", "parameter", "1", 1.0, "1: engaged at t0 with zero windup"),
-        Variable("r_outer", "parameter", "m", _S.r_outer, "outer race contact radius R_o"),
-        Variable("r_inner", "parameter", "m", _S.r_inner, "inner race contact radius R_i"),
-        Variable("r_sprag", "parameter", "m", _S.r_sprag, "sprag profile radius R_s"),
-        Variable("sprag_offset", "parameter", "m", _S.offset, "sprag curvature-centre offset a"),
-        Variable("n_sprags", "parameter", "1", _S.n_sprags, "number of sprags Z"),
-        Variable("strut_inner", "parameter", "rad", _S.strut_inner, "strut angle alpha"),
-        Variable("strut_outer", "parameter", "rad", _S.strut_outer, "strut angle beta"),
-        Variable("youngs", "parameter", "Pa", _S.youngs, "Young's modulus (races, sprags)"),
-        Variable("poisson", "parameter", "1", _S.poisson, "Poisson ratio"),
+        Variable(
+            "model",
+            "parameter",
+            "1",
+            MODEL_LUMPED,
+            "0: lumped K; 1: two-point Hertz",
+            min=0.0,
+            max=1.0,
+        ),
+        Variable(
+            "k", "parameter", "N.m", K_SP, "lumped stiffness K_sp [N.m/rad^1.5] (model 0)", min=0.0
+        ),
+        Variable("c_lin", "parameter", "N.m.s/rad", 0.0, "linear damping C_sp (Part I)", min=0.0),
+        Variable(
+            "c_nl", "parameter", "N.m.s", C_NL, "nonlinear damping C_nl [N.m.s/rad^1.25]", min=0.0
+        ),
+        Variable("n_damp", "parameter", "1", N_DAMP, "damping exponent n", min=0.0),
+        Variable(
+            "engaged0", "parameter", "1", 1.0, "1: engaged at t0 with zero windup", min=0.0, max=1.0
+        ),
+        Variable("r_outer", "parameter", "m", _S.r_outer, "outer race contact radius R_o", min=0.0),
+        Variable("r_inner", "parameter", "m", _S.r_inner, "inner race contact radius R_i", min=0.0),
+        Variable("r_sprag", "parameter", "m", _S.r_sprag, "sprag profile radius R_s", min=0.0),
+        Variable(
+            "sprag_offset", "parameter", "m", _S.offset, "sprag curvature-centre offset a", min=0.0
+        ),
+        Variable("n_sprags", "parameter", "1", _S.n_sprags, "number of sprags Z", min=1.0),
+        Variable(
+            "strut_inner",
+            "parameter",
+            "rad",
+            _S.strut_inner,
+            "strut angle alpha",
+            min=0.0,
+            max=0.5 * math.pi,
+        ),
+        Variable(
+            "strut_outer",
+            "parameter",
+            "rad",
+            _S.strut_outer,
+            "strut angle beta",
+            min=0.0,
+            max=0.5 * math.pi,
+        ),
+        Variable(
+            "youngs", "parameter", "Pa", _S.youngs, "Young's modulus (races, sprags)", min=0.0
+        ),
+        Variable("poisson", "parameter", "1", _S.poisson, "Poisson ratio", min=-1.0, max=0.5),
         Variable("angle_outer", "input", "rad", 0.0, "outer race angle (forward positive)"),
         Variable("speed_outer", "input", "rad/s", 0.0, "outer race speed"),
         Variable("angle_inner", "input", "rad", 0.0, "inner race angle (forward positive)"),
         Variable("speed_inner", "input", "rad/s", 0.0, "inner race speed"),
-        Variable("torque", "output", "N.m", 0.0, "torque transmitted outer -> inner (>= 0)"),
-        Variable("windup", "output", "rad", 0.0, "windup w >= 0 (0 while overrunning)"),
-        Variable("windup_rate", "output", "rad/s", 0.0, "relative speed outer - inner"),
-        Variable("event_indicator", "output", "1", 0.0, "w if engaged, rel. speed if not"),
-        Variable("contact_force", "output", "N", 0.0, "spring part of N_h per sprag"),
+        Variable(
+            "torque",
+            "output",
+            "N.m",
+            0.0,
+            "torque transmitted outer -> inner (>= 0)",
+            depends_on=_RACE_MOTION,
+        ),
+        Variable(
+            "windup",
+            "output",
+            "rad",
+            0.0,
+            "windup w >= 0 (0 while overrunning)",
+            depends_on=_RACE_ANGLES,
+        ),
+        Variable(
+            "windup_rate",
+            "output",
+            "rad/s",
+            0.0,
+            "relative speed outer - inner",
+            depends_on=_RACE_SPEEDS,
+        ),
+        Variable(
+            "event_indicator",
+            "output",
+            "1",
+            0.0,
+            "w if engaged, rel. speed if not",
+            depends_on=_RACE_MOTION,
+        ),
+        Variable(
+            "contact_force",
+            "output",
+            "N",
+            0.0,
+            "spring part of N_h per sprag",
+            depends_on=_RACE_ANGLES,
+        ),
         Variable("k_eff", "output", "N.m", 0.0, "stiffness in use [N.m/rad^1.5]"),
         Variable("event_time", "output", "s", -1.0, "time of the last regime change"),
         Variable("t_event", "output", "s", -1.0, "time of the last regime change"),
-        Variable("ind_clutch", "output", "1", 0.0, "w if engaged, rel. speed if not"),
-        *COMMON_OUTPUTS,
+        Variable(
+            "ind_clutch",
+            "output",
+            "1",
+            0.0,
+            "w if engaged, rel. speed if not",
+            depends_on=_RACE_MOTION,
+        ),
+        *common_outputs(stored_energy=_RACE_ANGLES),
     )
 
     def initialize(self, t0: float) -> None:

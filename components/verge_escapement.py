@@ -50,10 +50,10 @@ import math
 from collections.abc import Callable
 from typing import Any
 
-from components.base import COMMON_OUTPUTS, Component, ComponentError, Variable
-from components.gear_train import ESCAPE_WHEEL_PORT, advance
-from components.m739_data import M739, M739Data
-from components.verge_geometry import (
+from .base import Component, ComponentError, Variable, common_outputs
+from .gear_train import ESCAPE_WHEEL_PORT, advance
+from .m739_data import M739, M739Data
+from .verge_geometry import (
     TWO_PI,
     face_arms,
     fuze_angles,
@@ -79,6 +79,9 @@ IND_WHEEL_SPEED = 4
 IND_MESH_HI = 5
 IND_MESH_LO = 6
 IND_STOP = 7
+# Direct feedthrough of the verge: the wheel state, and with it the train's response.
+_WHEEL_STATE = ("phi", "phi_dot")
+_WHEEL_AND_TRAIN = (*_WHEEL_STATE, "J_ref", "T_ref", "c_load")
 # Wheel speed [rad/s] below which a located verge-speed zero in coupled motion is the
 # wheel's (psi_d = U phi_d with U of order 1; the event is located to about 1e-14 s).
 WHEEL_AT_REST = 1e-6
@@ -710,10 +713,17 @@ class VergeEscapement(Component):
     PORTS = {"escape_wheel": ESCAPE_WHEEL_PORT}
 
     VARIABLES = (
-        Variable("mu1", "parameter", "1", M739.mu1, "friction, tooth-face and verge pivot"),
-        Variable("mu", "parameter", "1", M739.mu, "friction, escape-wheel pivot (train mu)"),
-        Variable("spin", "parameter", "rad/s", M739.omega, "fuze spin rate omega"),
-        Variable("e_rest", "parameter", "1", M739.e_rest, "coefficient of restitution"),
+        Variable(
+            "mu1", "parameter", "1", M739.mu1, "friction, tooth-face and verge pivot", min=0.0
+        ),
+        Variable(
+            "mu", "parameter", "1", M739.mu, "friction, escape-wheel pivot (train mu)", min=0.0
+        ),
+        # The model takes |omega| (spin in either sense gives the same motion): spin >= 0.
+        Variable("spin", "parameter", "rad/s", M739.omega, "fuze spin rate omega", min=0.0),
+        Variable(
+            "e_rest", "parameter", "1", M739.e_rest, "coefficient of restitution", min=0.0, max=1.0
+        ),
         Variable(
             "phi_local_start",
             "parameter",
@@ -727,14 +737,19 @@ class VergeEscapement(Component):
             "m/s",
             1.0e-3,
             "closing speed below which contact is gentle (no impact)",
+            min=0.0,
         ),
-        Variable("h_max", "parameter", "s", 1.0e-6, "largest internal RK4 step"),
+        Variable("h_max", "parameter", "s", 1.0e-6, "largest internal RK4 step", min=0.0),
         Variable(
             "center_distance",
             "parameter",
             "m",
             M739.a,
             "escapement centre distance O_p-O_s (pallet pivot to escape-wheel pivot)",
+            # Where the pallet pivot can sit at R4 from the spin axis and the tooth tips
+            # can leave the faces (escapement_data): set by the part dimensions.
+            min=max(abs(M739.r3 - M739.r4), abs(M739.b - M739.c)),
+            max=min(M739.r3 + M739.r4, M739.b + M739.c),
         ),
         Variable(
             "pallet_inertia",
@@ -742,6 +757,7 @@ class VergeEscapement(Component):
             "kg.m2",
             M739.ip,
             "verge (pallet) moment of inertia about its pivot, I_p",
+            min=0.0,
         ),
         Variable("phi", "input", "rad", 0.0, "cumulative escape-wheel angle", sampled=True),
         Variable("phi_dot", "input", "rad/s", 0.0, "escape-wheel speed", sampled=True),
@@ -749,27 +765,115 @@ class VergeEscapement(Component):
         Variable("T_ref", "input", "N.m", 0.0, "train net torque at the wheel"),
         Variable("c_load", "input", "1", 1.0, "train factor on T_esc"),
         Variable("J_stot", "input", "kg.m2", M739.i_stot, "train inertia for impacts (B213)"),
-        Variable("psi", "output", "rad", 0.0, "verge angle, entrance-face coordinates"),
-        Variable("psi_dot", "output", "rad/s", 0.0, "verge speed"),
-        Variable("psi_local", "output", "rad", 0.0, "verge angle in the active face's frame"),
-        Variable("phi_local", "output", "rad", M739.phi_start, "wheel angle, active face frame"),
-        Variable("T_esc", "output", "N.m", 0.0, "escapement moment on the escape wheel"),
+        # Direct feedthrough: while coupled the verge follows the wheel angle and speed and
+        # the contact force follows the train's response too; free, the gap and the wheel's
+        # own acceleration follow the inputs.  J_stot acts only at an impact, in step().
+        Variable(
+            "psi",
+            "output",
+            "rad",
+            0.0,
+            "verge angle, entrance-face coordinates",
+            depends_on=("phi",),
+        ),
+        Variable("psi_dot", "output", "rad/s", 0.0, "verge speed", depends_on=_WHEEL_STATE),
+        Variable(
+            "psi_local",
+            "output",
+            "rad",
+            0.0,
+            "verge angle in the active face's frame",
+            depends_on=("phi",),
+        ),
+        Variable(
+            "phi_local",
+            "output",
+            "rad",
+            M739.phi_start,
+            "wheel angle, active face frame",
+            depends_on=("phi",),
+        ),
+        Variable(
+            "T_esc",
+            "output",
+            "N.m",
+            0.0,
+            "escapement moment on the escape wheel",
+            depends_on=_WHEEL_AND_TRAIN,
+        ),
         Variable(
             "T_esc_static",
             "output",
             "N.m",
             0.0,
             "T_esc at zero wheel acceleration: T_esc = T_esc_static - J_esc phi_ddot",
+            depends_on=_WHEEL_STATE,
         ),
-        Variable("J_esc", "output", "kg.m2", 0.0, "escapement inertia felt at the wheel (coupled)"),
-        Variable("phi_ddot", "output", "rad/s2", 0.0, "escape-wheel acceleration (own)"),
-        Variable("phi_dot_own", "output", "rad/s", 0.0, "escape-wheel speed (own copy)"),
-        Variable("PN", "output", "N", 0.0, "tooth-face normal force (coupled)"),
+        Variable(
+            "J_esc",
+            "output",
+            "kg.m2",
+            0.0,
+            "escapement inertia felt at the wheel (coupled)",
+            depends_on=_WHEEL_STATE,
+        ),
+        Variable(
+            "phi_ddot",
+            "output",
+            "rad/s2",
+            0.0,
+            "escape-wheel acceleration (own)",
+            depends_on=_WHEEL_AND_TRAIN,
+        ),
+        Variable(
+            "phi_dot_own",
+            "output",
+            "rad/s",
+            0.0,
+            "escape-wheel speed (own copy)",
+            depends_on=("phi_dot",),
+        ),
+        Variable(
+            "PN",
+            "output",
+            "N",
+            0.0,
+            "tooth-face normal force (coupled)",
+            depends_on=_WHEEL_AND_TRAIN,
+        ),
         Variable("face", "output", "1", ENTRANCE, "+1 entrance face active, -1 exit", "Integer"),
-        Variable("ind_face_end", "output", "m", 0.0, "sigma g (coupled) / sigma g' (free)"),
-        Variable("ind_gap", "output", "m", 0.0, "sigma f, normal gap of the tip (free)"),
-        Variable("ind_pn", "output", "N", 0.0, "Pn (coupled), zero at separation"),
-        Variable("v_close", "output", "m/s", 0.0, "closing speed sigma (V_SN - V_TN)"),
+        Variable(
+            "ind_face_end",
+            "output",
+            "m",
+            0.0,
+            "sigma g (coupled) / sigma g' (free)",
+            depends_on=("phi",),
+        ),
+        Variable(
+            "ind_gap",
+            "output",
+            "m",
+            0.0,
+            "sigma f, normal gap of the tip (free)",
+            depends_on=("phi",),
+        ),
+        Variable(
+            "ind_pn",
+            "output",
+            "N",
+            0.0,
+            "Pn (coupled), zero at separation",
+            depends_on=_WHEEL_AND_TRAIN,
+        ),
+        Variable(
+            "v_close",
+            "output",
+            "m/s",
+            0.0,
+            "closing speed sigma (V_SN - V_TN)",
+            depends_on=_WHEEL_STATE,
+        ),
         Variable("impact_count", "output", "1", 0, "impacts so far", "Integer"),
         Variable("phi_dot_post", "output", "rad/s", 0.0, "wheel speed after the last impact"),
         Variable("psi_dot_post", "output", "rad/s", 0.0, "verge speed after the last impact"),
@@ -781,10 +885,17 @@ class VergeEscapement(Component):
             "first regime change or impact of the last step that had one",
         ),
         Variable(
-            "J_load", "output", "kg.m2", 0.0, "verge inertia at the wheel, I_p U^2 (0 when free)"
+            "J_load",
+            "output",
+            "kg.m2",
+            0.0,
+            "verge inertia at the wheel, I_p U^2 (0 when free)",
+            depends_on=("phi",),
         ),
+        # It would follow psi (coupled: phi) through A54 = m_p r_cp R4 omega^2, which is zero
+        # for the M739 pallet (r_cp = 0): no feedthrough.
         Variable("external_work", "output", "J", 0.0, "work of the spin on the pallet"),
-        *COMMON_OUTPUTS,
+        *common_outputs(stored_energy=_WHEEL_STATE),
     )
 
     def initialize(self, t0: float) -> None:

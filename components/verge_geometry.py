@@ -15,7 +15,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from components.m739_data import M739Data
+from .m739_data import M739Data
 
 TWO_PI = 2.0 * math.pi
 

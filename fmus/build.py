@@ -1,18 +1,24 @@
 """Build component FMUs on demand, cached by content hash.
 
-Every FMU packs the whole ``components`` package and the generic slave, so it runs
-wherever Python with numpy and pythonfmu's runtime is present.  pythonfmu writes a model
-description without units and with an incomplete ModelStructure; ``_complete_description``
-adds the unit definitions, the unit of every Real, and the InitialUnknowns, so that the
-FMU passes fmpy's validation with no message.
+Each FMU stands alone.  Its Python code (the generic slave and the modules of
+``components`` its component imports) is packed as a package whose name carries the
+build's hash, ``mechcosim_<hash>``, and the wrapper module pythonfmu's runtime imports is
+named after the hash too.  So any number of our FMUs, and two builds of one FMU with
+different code, run each their own code in one process.  The third-party modules that
+code imports are written to ``resources/requirements.txt`` (pythonfmu's deploy command
+installs them), and ``documentation/index.html`` tells a user of another tool how to use
+the FMU.  ``fmus.description`` completes the model description.
 """
 
 from __future__ import annotations
 
+import ast
 import hashlib
 import importlib
 import os
+import re
 import shutil
+import sys
 import tempfile
 import zipfile
 from pathlib import Path
@@ -22,14 +28,29 @@ from xml.etree import ElementTree as ET
 import pythonfmu
 from pythonfmu.builder import FmuBuilder
 
-from components.base import Component, Variable
+from components.base import Component
+from fmus.description import complete_description
+from fmus.documentation import render_documentation
 from fmus.registry import FMU_WRAPPERS, FmuWrapper
-from fmus.units import base_unit_exponents
 
 FMUS_DIR = Path(__file__).resolve().parent
 PROJECT_DIR = FMUS_DIR.parent
 COMPONENTS_DIR = PROJECT_DIR / "components"
 SLAVE_MODULE = FMUS_DIR / "component_slave.py"
+#: Code that shapes every FMU: a change to any of it is a new build.
+BUILD_CODE = (
+    SLAVE_MODULE,
+    Path(__file__),
+    FMUS_DIR / "description.py",
+    FMUS_DIR / "documentation.py",
+    FMUS_DIR / "units.py",
+)
+#: Requirement lines for the third-party modules component code may import.
+REQUIREMENTS = {"numpy": "numpy>=1.26", "scipy": "scipy>=1.11"}
+
+
+class BuildError(RuntimeError):
+    """An FMU cannot be built (unknown name, unwritable cache, undeclared requirement)."""
 
 
 def default_cache_dir() -> Path:
@@ -41,18 +62,49 @@ def default_cache_dir() -> Path:
     return base / "mechcosim" / "fmus"
 
 
+def component_modules(wrapper: FmuWrapper) -> list[Path]:
+    """The modules of ``components`` the wrapper's component imports, itself included."""
+    start = COMPONENTS_DIR / f"{wrapper.component.split('.')[1]}.py"
+    found: list[Path] = [COMPONENTS_DIR / "__init__.py"]
+    todo = [start]
+    while todo:
+        module = todo.pop()
+        if module in found:
+            continue
+        found.append(module)
+        for node in ast.walk(ast.parse(module.read_text())):
+            if isinstance(node, ast.ImportFrom) and node.level == 1:
+                todo.append(COMPONENTS_DIR / f"{node.module}.py")
+    return sorted(found)
+
+
+def requirements(modules: list[Path]) -> list[str]:
+    """Requirement lines for the third-party modules that ``modules`` import."""
+    names: set[str] = set()
+    for module in modules:
+        for node in ast.walk(ast.parse(module.read_text())):
+            if isinstance(node, ast.Import):
+                names.update(a.name.split(".")[0] for a in node.names)
+            elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
+                names.add(node.module.split(".")[0])
+    third_party = sorted(names - set(sys.stdlib_module_names) - {"__future__"})
+    unknown = [n for n in third_party if n not in REQUIREMENTS]
+    if unknown:
+        raise BuildError(f"components import {unknown}: add them to fmus.build.REQUIREMENTS")
+    return [REQUIREMENTS[n] for n in third_party]
+
+
 def content_hash(wrapper: FmuWrapper) -> str:
-    """Hash of everything that ends up in the FMU (sources, slave, build code, pythonfmu)."""
+    """Hash of everything that ends up in the FMU (its code, build code, pythonfmu)."""
     h = hashlib.sha256()
-    files = sorted(COMPONENTS_DIR.rglob("*.py")) + [
-        wrapper.script,
-        SLAVE_MODULE,
-        Path(__file__),
-        FMUS_DIR / "units.py",
-    ]
-    for f in files:
+    for f in component_modules(wrapper):
+        h.update(f"components/{f.name}".encode())
+        h.update(f.read_bytes())
+    for f in [wrapper.script, *BUILD_CODE]:
         h.update(str(f.relative_to(PROJECT_DIR)).encode())
         h.update(f.read_bytes())
+    for example in wrapper.examples:  # the documentation lists their connections
+        h.update((PROJECT_DIR / example).read_bytes())
     h.update(pythonfmu.__version__.encode())
     return h.hexdigest()
 
@@ -62,29 +114,82 @@ def build_fmu(name: str, cache_dir: Path | None = None, force: bool = False) -> 
     try:
         wrapper = FMU_WRAPPERS[name]
     except KeyError:
-        raise KeyError(f"no FMU named {name!r}; known: {sorted(FMU_WRAPPERS)}") from None
+        raise BuildError(f"no FMU named {name!r}; known: {sorted(FMU_WRAPPERS)}") from None
     cache_dir = Path(cache_dir) if cache_dir else default_cache_dir()
-    cache_dir.mkdir(parents=True, exist_ok=True)
-    target = cache_dir / f"{name}-{content_hash(wrapper)[:16]}.fmu"
+    try:
+        cache_dir.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise BuildError(f"cannot use {cache_dir} as the FMU cache: {exc}") from None
+    digest = content_hash(wrapper)[:16]
+    target = cache_dir / f"{name}-{digest}.fmu"
     if target.exists() and not force:
         return target
     with tempfile.TemporaryDirectory(prefix="mechcosim_build_") as tmp:
-        built = FmuBuilder.build_FMU(
-            wrapper.script,
-            dest=tmp,
-            project_files=[COMPONENTS_DIR, SLAVE_MODULE],
-            canGetAndSetFMUstate=True,
-        )
-        component_class = _component_class(wrapper)
-        _rewrite_description(Path(built), component_class)
-        partial = target.with_suffix(".fmu.part")
-        shutil.copyfile(built, partial)
-        partial.replace(target)  # atomic: a parallel build never sees half a file
+        built = _build(wrapper, digest, Path(tmp))
+        # A name of its own per builder, then an atomic rename: parallel builds of one FMU
+        # never see half a file or each other's part.
+        try:
+            fd, partial = tempfile.mkstemp(prefix=f".{name}-", suffix=".part", dir=cache_dir)
+            os.close(fd)
+            shutil.copyfile(built, partial)
+            os.replace(partial, target)
+        except OSError as exc:
+            raise BuildError(f"cannot write {target}: {exc}") from None
     return target
 
 
 def build_all(cache_dir: Path | None = None, force: bool = False) -> dict[str, Path]:
     return {name: build_fmu(name, cache_dir, force) for name in FMU_WRAPPERS}
+
+
+def package_name(digest: str) -> str:
+    """The package an FMU's Python code is packed as: unique to the build."""
+    return f"mechcosim_{digest}"
+
+
+def _build(wrapper: FmuWrapper, digest: str, tmp: Path) -> Path:
+    package = package_name(digest)
+    modules = component_modules(wrapper)
+    needs = requirements(modules)
+    stage = tmp / "stage"
+    code = stage / package
+    (code / "components").mkdir(parents=True)
+    (code / "__init__.py").write_text('"""Python code of one mechcosim FMU build."""\n')
+    shutil.copy2(SLAVE_MODULE, code)
+    for module in modules:
+        shutil.copy2(module, code / "components")
+    script = stage / f"{wrapper.script.stem}_{digest}.py"
+    script.write_text(
+        re.sub(
+            r"^from component_slave import",
+            f"from {package}.component_slave import",
+            wrapper.script.read_text(),
+            flags=re.M,
+        )
+    )
+    (stage / "requirements.txt").write_text("".join(f"{line}\n" for line in needs))
+    docs = tmp / "documentation"
+    docs.mkdir()
+    component_class = _component_class(wrapper)
+    (docs / "index.html").write_text(render_documentation(wrapper, component_class, needs))
+    modules_before = set(sys.modules)
+    try:
+        built = FmuBuilder.build_FMU(
+            script,
+            dest=tmp / "out",
+            project_files=[code, stage / "requirements.txt"],
+            documentation_folder=docs,
+            canGetAndSetFMUstate=True,
+        )
+    finally:
+        # The builder imports the staged code from a folder that is about to go: forget it.
+        for module in set(sys.modules) - modules_before:
+            if module.startswith((package, script.stem)):
+                del sys.modules[module]
+        while str(stage) in sys.path:
+            sys.path.remove(str(stage))
+    _rewrite_description(Path(built), component_class)
+    return Path(built)
 
 
 def _component_class(wrapper: FmuWrapper) -> type[Component]:
@@ -99,46 +204,9 @@ def _rewrite_description(fmu: Path, component_class: type[Component]) -> None:
     for element in root.iter():  # drop pythonfmu's indentation before printing anew
         element.text = element.text.strip() if element.text else None
         element.tail = None
-    _complete_description(root, component_class)
+    complete_description(root, component_class)
     xml = parseString(ET.tostring(root, "UTF-8")).toprettyxml(indent="  ", encoding="UTF-8")
     members["modelDescription.xml"] = xml
     with zipfile.ZipFile(fmu, "w", zipfile.ZIP_DEFLATED) as z:
         for n, data in members.items():
             z.writestr(n, data)
-
-
-def _complete_description(root: ET.Element, component_class: type[Component]) -> None:
-    """Add units and InitialUnknowns to a pythonfmu model description, in place."""
-    by_name: dict[str, Variable] = {v.name: v for v in component_class.VARIABLES}
-    model_vars = root.find("ModelVariables")
-    units_used: list[str] = []
-    output_indices: list[int] = []
-    for index, sv in enumerate(model_vars.findall("ScalarVariable"), start=1):
-        var = by_name[sv.get("name")]
-        real = sv.find("Real")
-        if real is not None and var.unit != "1":
-            real.set("unit", var.unit)
-            if var.unit not in units_used:
-                units_used.append(var.unit)
-        if var.causality == "output":
-            output_indices.append(index)
-
-    if units_used:
-        unit_defs = ET.Element("UnitDefinitions")
-        for unit in units_used:
-            u = ET.SubElement(unit_defs, "Unit", name=unit)
-            exps = {k: str(v) for k, v in base_unit_exponents(unit).items() if v}
-            ET.SubElement(u, "BaseUnit", exps)
-        # FMI 2.0 order: CoSimulation, UnitDefinitions, TypeDefinitions, LogCategories, ...
-        position = list(root).index(root.find("CoSimulation")) + 1
-        root.insert(position, unit_defs)
-
-    structure = root.find("ModelStructure")
-    for child in list(structure):
-        structure.remove(child)
-    if output_indices:
-        outputs = ET.SubElement(structure, "Outputs")
-        initial = ET.SubElement(structure, "InitialUnknowns")
-        for i in output_indices:
-            ET.SubElement(outputs, "Unknown", index=str(i))
-            ET.SubElement(initial, "Unknown", index=str(i))

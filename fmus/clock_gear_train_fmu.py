@@ -2,10 +2,8 @@
 
 from component_slave import ComponentSlave
 
-from components.clock_gear_train import ClockGearTrain as _Component
-
 
 class ClockGearTrain(ComponentSlave):
-    component_class = _Component
+    component = "clock_gear_train.ClockGearTrain"
     description = "Spin-driven M739 rotor behind a two-pass clock gear train"
     default_run = (0.0, 0.01, 1.0e-5)

@@ -1,25 +1,45 @@
 """The one FMI 2.0 co-simulation slave every component is wrapped in.
 
-A wrapper module in fmus/ only names its component class; this class registers the
-component's VARIABLES as FMI variables, forwards the life cycle, and saves and restores
-the component's complete state (pythonfmu alone would save registered variables only).
+A wrapper module in fmus/ only names its component; this class registers the component's
+VARIABLES as FMI variables, forwards the life cycle, and saves and restores the
+component's complete state (pythonfmu alone would save registered variables only).
 
-This module is packed inside every FMU next to the ``components`` package, so it may
-import only the standard library, numpy, pythonfmu and ``components``.
+Inside an FMU this module sits in a package whose name is unique to the build, next to
+that build's ``components`` package, so several FMUs (or two builds of one) run each
+their own code in one process.  It imports only the standard library and pythonfmu
+(packed too); the component and what it needs (numpy, scipy) are imported when an
+instance is made, so that a missing module is reported through the FMU's logger.
+
+FMI calls defend themselves.  pythonfmu's runtime (0.7) turns an exception raised in
+Python into fmi2Fatal, after which the instance cannot be used (a later call may crash the
+host), and a ``do_step`` that returns False into fmi2Discard.  So a step of non-positive
+or non-finite size, from a non-finite time, or with a non-finite Real set on the FMU since
+the last step, is refused with fmi2Discard and nothing changes: the instance stays usable.
+Non-finite parameters fail initialization.  The reason goes to the FMU's log, which
+pythonfmu's runtime forwards to the host only when debug logging is on; a missing module,
+which ends instantiation before any logging, is also written to standard error.
 """
 
 from __future__ import annotations
 
 import ctypes
+import importlib
+import math
 import sys
 import traceback
-from typing import Any, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar
 
 from pythonfmu import Fmi2Causality, Fmi2Slave, Fmi2Variability, Integer, Real
 from pythonfmu.default_experiment import DefaultExperiment
 from pythonfmu.enums import Fmi2Status
 
-from components.base import Component
+if TYPE_CHECKING:
+    from components.base import Component
+
+
+class FmiCallError(ValueError):
+    """An FMI call the FMU cannot accept."""
+
 
 _CAUSALITY = {
     "parameter": Fmi2Causality.parameter,
@@ -29,9 +49,10 @@ _CAUSALITY = {
 
 
 class ComponentSlave(Fmi2Slave):
-    """Generic slave: subclasses set ``component_class`` and the metadata below."""
+    """Generic slave: subclasses set ``component`` and the metadata below."""
 
-    component_class: ClassVar[type[Component]]
+    #: "module.Class" of the component, the module inside the ``components`` package
+    component: ClassVar[str]
     description: ClassVar[str] = ""
     #: (start, stop, step) of the experiment `fmpy simulate` runs when given the FMU alone
     default_run: ClassVar[tuple[float, float, float]] = (0.0, 1.0, 1.0e-3)
@@ -53,18 +74,30 @@ class ComponentSlave(Fmi2Slave):
         super().__init__(**kwargs)
         start, stop, step = self.default_run
         self.default_experiment = DefaultExperiment(start, stop, step)
-        self.component = self.component_class()
+        try:
+            self.component_class = _component_class(self.component)
+        except ImportError as exc:  # a module the FMU needs is not installed in this Python
+            message = (
+                f"{type(self).__name__} cannot load its Python code: {exc}. Install the "
+                "packages listed in the FMU's resources/requirements.txt into the Python "
+                f"that runs it ({sys.executable}, Python {sys.version.split()[0]})"
+            )
+            self.log(message, Fmi2Status.error)
+            print(f"[{self.instance_name}] {message}", file=sys.stderr, flush=True)
+            raise
+        self.model = self.component_class()
         self._names: list[str] = []
         self._inputs: set[int] = set()
         self._feedthrough_stale = False
         self._initializing = False
         self._init_stale = False
         self._start_time = 0.0
+        self._not_finite: set[str] = set()  # Reals whose last value set is NaN or inf
         for var in self.component_class.VARIABLES:
             self._register(var)
 
     def _register(self, var: Any) -> None:
-        comp = self.component
+        comp = self.model
         name = var.name
         kind = Integer if var.type == "Integer" else Real
         if var.causality == "parameter":
@@ -92,6 +125,8 @@ class ComponentSlave(Fmi2Slave):
     # consistent inputs), so the component is (re)initialized from the current parameters
     # whenever something was set and an output is read, and once more on leaving the mode.
     def setup_experiment(self, start_time: float, stop_time: float | None, tolerance: float | None):
+        if not math.isfinite(start_time):
+            raise self._refuse(f"setupExperiment: start time {start_time} is not finite")
         self._start_time = float(start_time)
 
     def enter_initialization_mode(self) -> None:
@@ -99,8 +134,16 @@ class ComponentSlave(Fmi2Slave):
         self._init_stale = True
 
     def exit_initialization_mode(self) -> None:
-        self.component.initialize(self._start_time)
-        self.component.update_outputs()
+        bad = [
+            v.name
+            for v in self.component_class.VARIABLES
+            if v.type == "Real" and not math.isfinite(getattr(self.model, v.name))
+        ]
+        if bad:
+            raise self._refuse(f"initialization: not finite: {', '.join(bad)}")
+        self._not_finite.clear()
+        self.model.initialize(self._start_time)
+        self.model.update_outputs()
         self._initializing = False
         self._init_stale = False
         self._feedthrough_stale = False
@@ -108,50 +151,70 @@ class ComponentSlave(Fmi2Slave):
     def _refresh(self) -> None:
         if self._initializing:
             if self._init_stale:
-                self.component.initialize(self._start_time)
-                self.component.update_outputs()
+                self.model.initialize(self._start_time)
+                self.model.update_outputs()
                 self._init_stale = False
         elif self._feedthrough_stale:
-            self.component.update_outputs()
+            self.model.update_outputs()
         self._feedthrough_stale = False
 
     def do_step(self, current_time: float, step_size: float) -> bool:
+        refusal = ""
+        if not (math.isfinite(current_time) and math.isfinite(current_time + step_size)):
+            refusal = f"time {current_time} or step size {step_size} is not finite"
+        elif not step_size > 0.0:
+            refusal = f"step size {step_size} is not positive"
+        elif self._not_finite:
+            refusal = f"values set are not finite: {', '.join(sorted(self._not_finite))}"
+        if refusal:  # fmi2Discard, nothing changed: the instance stays usable
+            self._refuse(f"doStep at t = {current_time} refused: {refusal}")
+            return False
         try:
             if self._feedthrough_stale:
                 self._refresh()
-            self.component.step(current_time, step_size)
+            self.model.step(current_time, step_size)
         except Exception as exc:  # the FMU cannot go on: say why through the FMI logger
             self.log(
-                f"{type(exc).__name__}: {exc}\n{traceback.format_exc(limit=3)}",
-                Fmi2Status.error,
+                f"{type(exc).__name__}: {exc}\n{traceback.format_exc(limit=3)}", Fmi2Status.error
             )
             return False
         return True
+
+    def _refuse(self, message: str) -> FmiCallError:
+        """Log why a call is refused; the result is for the caller to raise, if it must."""
+        self.log(message, Fmi2Status.error)
+        return FmiCallError(message)
 
     # -- lean variable access (the hot path of every master step) ----------------------
     def get_real(self, vrs: list[int]) -> list[float]:
         if self._feedthrough_stale or self._initializing:
             self._refresh()
-        comp = self.component
+        comp = self.model
         names = self._names
         return [float(getattr(comp, names[vr])) for vr in vrs]
 
     def get_integer(self, vrs: list[int]) -> list[int]:
         if self._feedthrough_stale or self._initializing:
             self._refresh()
-        comp = self.component
+        comp = self.model
         names = self._names
         return [int(getattr(comp, names[vr])) for vr in vrs]
 
     def set_real(self, vrs: list[int], values: list[float]) -> None:
-        comp = self.component
+        comp = self.model
         names = self._names
+        if not all(map(math.isfinite, values)) or self._not_finite:
+            # Refused at the next step (see do_step), until set to finite values again.
+            for vr, value in zip(vrs, values, strict=True):
+                (self._not_finite.discard if math.isfinite(value) else self._not_finite.add)(
+                    names[vr]
+                )
         for vr, value in zip(vrs, values, strict=True):
             setattr(comp, names[vr], float(value))
         self._feedthrough_stale = self._init_stale = True
 
     def set_integer(self, vrs: list[int], values: list[int]) -> None:
-        comp = self.component
+        comp = self.model
         names = self._names
         for vr, value in zip(vrs, values, strict=True):
             setattr(comp, names[vr], int(value))
@@ -159,8 +222,21 @@ class ComponentSlave(Fmi2Slave):
 
     # -- complete state ---------------------------------------------------------------
     def _get_fmu_state(self) -> dict[str, Any]:
-        return {"component": self.component.get_state(), "stale": self._feedthrough_stale}
+        return {
+            "component": self.model.get_state(),
+            "stale": self._feedthrough_stale,
+            "not_finite": frozenset(self._not_finite),
+        }
 
     def _set_fmu_state(self, state: dict[str, Any]) -> None:
-        self.component.set_state(state["component"])
+        self.model.set_state(state["component"])
         self._feedthrough_stale = state["stale"]
+        self._not_finite = set(state["not_finite"])
+
+
+def _component_class(path: str) -> type[Component]:
+    """The component class named "module.Class" in the ``components`` package beside this
+    module (inside an FMU, the build's own copy)."""
+    module, name = path.rsplit(".", 1)
+    package = __package__ + ".components" if __package__ else "components"
+    return getattr(importlib.import_module(f"{package}.{module}"), name)

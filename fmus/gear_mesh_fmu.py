@@ -2,10 +2,8 @@
 
 from component_slave import ComponentSlave
 
-from components.gear_mesh import GearMesh as _Component
-
 
 class GearMesh(ComponentSlave):
-    component_class = _Component
+    component = "gear_mesh.GearMesh"
     description = "Gear pair driven at a set speed against a load torque, mesh friction losses"
     default_run = (0.0, 0.1, 1.0e-3)

@@ -2,10 +2,8 @@
 
 from component_slave import ComponentSlave
 
-from components.rotational import Inertia as _Component
-
 
 class Inertia(ComponentSlave):
-    component_class = _Component
+    component = "rotational.Inertia"
     description = "Rigid body on a frictionless pivot driven by an input torque"
     default_run = (0.0, 1.0, 1.0e-3)

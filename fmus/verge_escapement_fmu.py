@@ -2,10 +2,8 @@
 
 from component_slave import ComponentSlave
 
-from components.verge_escapement import VergeEscapement as _Component
-
 
 class VergeEscapement(ComponentSlave):
-    component_class = _Component
+    component = "verge_escapement.VergeEscapement"
     description = "Straight-sided verge runaway escapement of the M739 S&A"
     default_run = (0.0, 0.01, 1.0e-5)

@@ -96,9 +96,11 @@ def main(argv: list[str] | None = None) -> int:
     p.set_defaults(handler=_report)
 
     args = parser.parse_args(argv)
+    from fmus.build import BuildError
+
     try:
         return args.handler(args)
-    except (ScenarioError, RunError) as exc:
+    except (ScenarioError, RunError, BuildError) as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
 
@@ -142,6 +144,8 @@ def _run(args: argparse.Namespace) -> int:
         print(f"  {name:32s} {value} {q['unit']}")
     for name, value in result.accuracy.items():
         print(f"  {name:32s} {value:.4g}")
+    for warning in result.stats.extra.get("warnings", []):
+        print(f"  warning: {warning}")
     s = result.stats
     print(
         f"  steps {s.steps}, doSteps {s.do_steps}, rejections {s.rejections}, "

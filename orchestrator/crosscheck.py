@@ -11,17 +11,17 @@ from pathlib import Path
 
 import numpy as np
 
-from fmus.build import build_fmu
 from orchestrator.errors import RunError
+from orchestrator.run import fmu_files
 from orchestrator.scenario import Scene
 
 
 def run_with_libcosim(scene: Scene, cache_dir: Path | None = None) -> tuple[list[str], np.ndarray]:
     """Recorded Real signals after each of libcosim's fixed steps (the start row is absent)."""
-    paths = {spec.fmu: str(build_fmu(spec.fmu, cache_dir)) for spec in scene.fmus.values()}
+    paths = fmu_files(scene, cache_dir)
     job = {
         "fmus": [
-            (name, paths[spec.fmu], spec.parameters, spec.inputs)
+            (name, str(paths[name]), spec.parameters, spec.inputs)
             for name, spec in scene.fmus.items()
         ],
         "connections": [(c.source, c.target) for c in scene.connections],

@@ -82,16 +82,20 @@ class FmuInstance:
             raise RunError(f"has no variable {exc.args[0]!r}", fmu=self.name) from None
 
     def is_integer(self, name: str) -> bool:
-        return self.variables[name].type == "Integer"
+        """Read and written with fmi2Get/SetInteger (Integer and Enumeration)."""
+        return self.variables[name].type in ("Integer", "Enumeration")
 
     # -- life cycle -------------------------------------------------------------------
     def initialize(self, start: float, stop: float, values: dict[str, float]) -> None:
         """Set parameters and input start values, then leave initialization mode."""
+        logged = len(self.messages)
         try:
             self.fmu.setupExperiment(startTime=start, stopTime=stop)
             self.fmu.enterInitializationMode()
             for name, value in values.items():
-                if self.is_integer(name):
+                if self.variables[name].type == "Boolean":
+                    self.fmu.setBoolean(self.refs([name]), [bool(value)])
+                elif self.is_integer(name):
                     self.fmu.setInteger(self.refs([name]), [int(value)])
                 else:
                     self.fmu.setReal(self.refs([name]), [value])
@@ -101,18 +105,22 @@ class FmuInstance:
             # initialization raised: leave it allocated (a small leak, once per failed run).
             self._alive = self._freeable = False
             raise RunError(
-                f"initialization failed: {self.last_message() or exc}", start, self.name
+                f"initialization failed: {self.said_since(logged) or exc}", start, self.name
             ) from None
 
     def do_step(self, t: float, h: float) -> None:
+        logged = len(self.messages)
         try:
             self.fmu.doStep(t, h)
         except FMICallException as exc:
             self._alive = False
-            raise RunError(f"doStep failed: {self.last_message() or exc}", t, self.name) from None
+            raise RunError(
+                f"doStep failed: {self.said_since(logged) or exc}", t, self.name
+            ) from None
 
-    def last_message(self) -> str:
-        return self.messages[-1].strip() if self.messages else ""
+    def said_since(self, index: int) -> str:
+        """What the FMU logged since ``index`` (its reason first, the runtime's after)."""
+        return "; ".join(m.strip() for m in self.messages[index:] if m.strip())
 
     # -- values -----------------------------------------------------------------------
     def get_real(self, refs: list[int]) -> list[float]:

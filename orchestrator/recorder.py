@@ -88,12 +88,9 @@ class RegimeLog:
     """
 
     def __init__(self, system: Any, scene: Any, recorder: Recorder) -> None:
-        from orchestrator.scenario import component_class
-
         self.system, self.recorder = system, recorder
-        self.names = [
-            getattr(component_class(scene.fmus[n].fmu), "REGIME_NAMES", {}) for n in system.names
-        ]
+        # Names of the regimes, from each FMU's Enumeration type (none: the numbers).
+        self.names = [scene.fmus[n].model.regime_names for n in system.names]
         self.last = system.regimes()
 
     def update(self, t: float) -> int:

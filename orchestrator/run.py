@@ -63,7 +63,7 @@ def run_scene(
 ) -> RunResult:
     """Run ``scene`` and write its results under ``output_dir`` (default: the scene's)."""
     out = Path(output_dir) if output_dir else scene.output_dir
-    fmu_paths = {spec.fmu: build_fmu(spec.fmu, cache_dir) for spec in scene.fmus.values()}
+    fmu_paths = fmu_files(scene, cache_dir)
     system = CoupledSystem(scene, fmu_paths)
     recorder = Recorder(out, system.record_header)
     stats = StepStats()
@@ -137,6 +137,15 @@ def run_scene(
     )
 
 
+def fmu_files(scene: Scene, cache_dir: Path | None = None) -> dict[str, Path]:
+    """Instance -> FMU file: the scene's, ours taken from ``cache_dir`` when one is given
+    (the same build: the file name is its content hash)."""
+    return {
+        name: build_fmu(spec.component, cache_dir) if spec.component and cache_dir else spec.path
+        for name, spec in scene.fmus.items()
+    }
+
+
 def reference_of(scene: Scene) -> Reference:
     """The scene's reference, timed (wall_time is filled in)."""
     start = time.perf_counter()
@@ -155,7 +164,10 @@ def _metadata(scene: Scene, fmu_paths: dict[str, Path]) -> dict[str, Any]:
     return {
         "scene_file": str(scene.path),
         "scene_sha256": file_sha256(scene.path),
-        "fmus": {name: {"file": p.name, "sha256": file_sha256(p)} for name, p in fmu_paths.items()},
+        "fmus": {
+            name: {"file": p.name, "sha256": file_sha256(p), "model": scene.fmus[name].fmu}
+            for name, p in fmu_paths.items()
+        },
         "master": {
             "algorithm": scene.master.algorithm,
             "step": scene.master.step,

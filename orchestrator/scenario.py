@@ -15,8 +15,10 @@ from pathlib import Path
 from typing import Any
 
 from components.base import Component
+from fmus.build import BuildError, build_fmu
 from fmus.registry import FMU_WRAPPERS
 from orchestrator.errors import ScenarioError
+from orchestrator.model_info import ModelInfo, ModelInfoError, VariableInfo, model_info
 from orchestrator.units import to_si
 
 ALGORITHMS = ("jacobi", "gauss-seidel", "regime-aware")
@@ -42,9 +44,12 @@ _MASTER_CHOICES: dict[str, tuple[str, ...]] = {"input_hold": ("start", "midpoint
 @dataclass(frozen=True)
 class FmuSpec:
     instance: str
-    fmu: str  # name in fmus.registry
-    parameters: dict[str, float]
-    inputs: dict[str, float]  # start values of inputs
+    fmu: str  # our component's name in fmus.registry, or the FMU file's model name
+    path: Path  # the FMU file (ours: built and cached; another tool's: as the scene names it)
+    model: ModelInfo  # everything the orchestrator knows of the FMU, read from the file
+    parameters: dict[str, Any]  # SI values (int for Integer, bool for Boolean)
+    inputs: dict[str, Any]  # start values of inputs
+    component: str | None = None  # name in fmus.registry when the scene names one of ours
 
 
 @dataclass(frozen=True)
@@ -118,7 +123,12 @@ class Scene:
     sweep: SweepSpec | None = None  # run by ``mechcosim sweep``; ``run`` ignores it
 
     def component_class(self, instance: str) -> type[Component]:
-        return component_class(self.fmus[instance].fmu)
+        """The physics behind one of our FMUs (for scene analyses and references only:
+        masters, recorder and system know the FMUs through their files)."""
+        component = self.fmus[instance].component
+        if component is None:
+            raise ValueError(f"FMU instance {instance!r} is not one of this project's components")
+        return component_class(component)
 
 
 def component_class(fmu_name: str) -> type[Component]:
@@ -126,10 +136,15 @@ def component_class(fmu_name: str) -> type[Component]:
     return getattr(importlib.import_module(module_name), class_name)
 
 
-def load_scene(path: str | Path, overrides: dict[str, Any] | None = None) -> Scene:
+def load_scene(
+    path: str | Path, overrides: dict[str, Any] | None = None, cache_dir: Path | None = None
+) -> Scene:
     """Read, validate and convert a scenario file; ``overrides`` patch the raw TOML first.
 
-    Overrides use dotted keys, e.g. {"master.step": "1 ms", "fmus.a.parameters.J": 2e-3}.
+    Overrides use dotted keys, e.g. {"master.step": "1 ms", "fmus.a.parameters.J": 2e-3};
+    a variable name after ``parameters.`` or ``inputs.`` may itself hold dots
+    ("fmus.c.parameters.inertia1.J").  The FMUs the scene names are built (ours, into
+    ``cache_dir``) or read, so that everything is checked against their model descriptions.
     """
     path = Path(path)
     try:
@@ -140,20 +155,28 @@ def load_scene(path: str | Path, overrides: dict[str, Any] | None = None) -> Sce
         raise ScenarioError(path, "", f"not valid TOML: {exc}") from None
     for dotted, value in (overrides or {}).items():
         _set_dotted(raw, dotted, value)
-    return _Loader(path, raw).scene()
+    return _Loader(path, raw, cache_dir).scene()
 
 
 def _set_dotted(raw: dict[str, Any], dotted: str, value: Any) -> None:
-    *parents, last = dotted.split(".")
+    *parents, last = _split_key(dotted)
     node = raw
     for key in parents:
         node = node.setdefault(key, {})
     node[last] = value
 
 
+def _split_key(dotted: str) -> list[str]:
+    """Split a dotted key; an FMU variable's own name (after parameters/inputs) stays whole."""
+    parts = dotted.split(".")
+    if len(parts) > 4 and parts[0] == "fmus" and parts[2] in ("parameters", "inputs"):
+        return [*parts[:3], ".".join(parts[3:])]
+    return parts
+
+
 class _Loader:
-    def __init__(self, path: Path, raw: dict[str, Any]) -> None:
-        self.path, self.raw = path, raw
+    def __init__(self, path: Path, raw: dict[str, Any], cache_dir: Path | None) -> None:
+        self.path, self.raw, self.cache_dir = path, raw, cache_dir
 
     def fail(self, key: str, message: str) -> ScenarioError:
         return ScenarioError(self.path, key, message)
@@ -245,10 +268,10 @@ class _Loader:
         if ("above" in node) == ("below" in node):
             raise self.fail(key, "expected exactly one of 'above' or 'below' (the threshold)")
         side = "above" if "above" in node else "below"
-        var = component_class(fmus[signal[0]].fmu).variable(signal[1])
+        var = fmus[signal[0]].model.variables[signal[1]]
         if var.type != "Real":
             raise self.fail(f"{key}.signal", f"{signal[1]!r} is not a Real output")
-        threshold = self.quantity(node[side], f"{key}.{side}", var.unit)
+        threshold = self.quantity(node[side], f"{key}.{side}", var.unit or "1")
         return StopCondition(signal, threshold, rising=side == "above")
 
     def fmus(self, node: dict[str, Any]) -> dict[str, FmuSpec]:
@@ -257,39 +280,92 @@ class _Loader:
         specs = {}
         for instance, entry in node.items():
             key = f"fmus.{instance}"
+            if not instance.isidentifier():
+                raise self.fail(key, "an instance name is a plain identifier (no dots or spaces)")
             entry = self.table(entry, key)
-            self.check_keys(entry, key, {"component", "parameters", "inputs"})
-            fmu = self.string(entry, "component", f"{key}.component")
-            if fmu not in FMU_WRAPPERS:
-                raise self.fail(
-                    f"{key}.component", f"unknown {fmu!r}; expected one of {sorted(FMU_WRAPPERS)}"
-                )
-            cls = component_class(fmu)
-            params = self.values(entry.get("parameters", {}), f"{key}.parameters", cls, "parameter")
-            inputs = self.values(entry.get("inputs", {}), f"{key}.inputs", cls, "input")
-            specs[instance] = FmuSpec(instance, fmu, params, inputs)
+            self.check_keys(entry, key, {"component", "fmu", "parameters", "inputs"})
+            component, path = self.fmu_file(entry, key)
+            try:
+                model = model_info(path)
+            except ModelInfoError as exc:
+                raise self.fail(f"{key}.fmu", str(exc)) from None
+            params = self.values(entry.get("parameters", {}), f"{key}.parameters", model)
+            inputs = self.values(entry.get("inputs", {}), f"{key}.inputs", model)
+            name = component or model.model_name
+            specs[instance] = FmuSpec(instance, name, path, model, params, inputs, component)
         return specs
 
-    def values(self, node: Any, key: str, cls: type[Component], causality: str) -> dict[str, float]:
+    def fmu_file(self, entry: dict[str, Any], key: str) -> tuple[str | None, Path]:
+        """(registry name or None, FMU file) of one [fmus.<instance>] table."""
+        if ("component" in entry) == ("fmu" in entry):
+            raise self.fail(
+                key,
+                f"expected exactly one of 'component' (one of {sorted(FMU_WRAPPERS)}) or "
+                "'fmu' (the path of an FMI 2.0 co-simulation FMU, relative to the scene file)",
+            )
+        if "fmu" in entry:
+            text = self.string(entry, "fmu", f"{key}.fmu")
+            path = (self.path.parent / text).resolve()
+            if not path.is_file():
+                raise self.fail(f"{key}.fmu", f"no FMU file at {path}")
+            return None, path
+        component = self.string(entry, "component", f"{key}.component")
+        if component not in FMU_WRAPPERS:
+            raise self.fail(
+                f"{key}.component",
+                f"unknown {component!r}; expected one of {sorted(FMU_WRAPPERS)}",
+            )
+        try:
+            return component, build_fmu(component, self.cache_dir)
+        except BuildError as exc:
+            raise self.fail(f"{key}.component", str(exc)) from None
+
+    def values(self, node: Any, key: str, model: ModelInfo) -> dict[str, Any]:
+        """Values given for parameters or inputs (``key`` ends in which), in SI, checked
+        against the variable's type, unit and range."""
+        causality = "parameter" if key.endswith(".parameters") else "input"
         node = self.table(node, key)
-        declared = {v.name: v for v in cls.variables(causality)}  # type: ignore[arg-type]
+        declared = {v.name: v for v in model.of(causality)}
         self.check_keys(node, key, set(declared))
-        return {
-            name: self.quantity(v, f"{key}.{name}", declared[name].unit) for name, v in node.items()
-        }
+        return {name: self.value(v, f"{key}.{name}", declared[name]) for name, v in node.items()}
+
+    def value(self, raw: Any, key: str, var: VariableInfo) -> Any:
+        if var.type == "Boolean":
+            if not isinstance(raw, bool):
+                raise self.fail(key, f"expected true or false, got {raw!r}")
+            return raw
+        if var.type == "String":
+            raise self.fail(key, "String variables cannot be set from a scene")
+        if var.is_integer:
+            if isinstance(raw, bool) or not isinstance(raw, int):
+                raise self.fail(key, f"expected an integer ({var.type}), got {raw!r}")
+            value: float = raw
+        else:
+            value = self.quantity(raw, key, var.unit or "1")
+            if not math.isfinite(value):
+                raise self.fail(key, f"expected a finite value, got {raw!r}")
+        low = var.min if var.min is not None else -math.inf
+        high = var.max if var.max is not None else math.inf
+        if not low <= value <= high:
+            unit = f" {var.unit}" if var.unit else ""
+            raise self.fail(
+                key, f"{value:g}{unit} is outside the valid range [{low:g}, {high:g}]{unit}"
+            )
+        return value
 
     def signal(
         self, text: Any, key: str, fmus: dict[str, FmuSpec], causality: str | None
     ) -> tuple[str, str]:
-        if not isinstance(text, str) or text.count(".") != 1:
+        if not isinstance(text, str) or "." not in text:
             raise self.fail(key, f"expected '<instance>.<variable>', got {text!r}")
-        instance, var = text.split(".")
+        instance, var = text.split(".", 1)  # a variable's own name may hold dots
         if instance not in fmus:
             raise self.fail(key, f"no FMU instance {instance!r}; expected one of {sorted(fmus)}")
-        cls = component_class(fmus[instance].fmu)
-        names = {v.name: v for v in cls.VARIABLES}
-        if var not in names or (causality and names[var].causality != causality):
-            wanted = [v.name for v in cls.VARIABLES if not causality or v.causality == causality]
+        variables = fmus[instance].model.variables
+        if var not in variables or (causality and variables[var].causality != causality):
+            wanted = [
+                v.name for v in variables.values() if not causality or v.causality == causality
+            ]
             kind = f"{causality} " if causality else ""
             owner = f"{instance!r} ({fmus[instance].fmu})"
             raise self.fail(key, f"{owner} has no {kind}variable {var!r}; expected one of {wanted}")
@@ -304,7 +380,9 @@ class _Loader:
             entry = self.table(entry, key)
             if "ports" in entry:
                 self.check_keys(entry, key, {"ports"})
-                result.extend(self.port_connection(entry["ports"], f"{key}.ports", fmus))
+                for c in self.port_connection(entry["ports"], f"{key}.ports", fmus):
+                    self.check_connection(c, fmus, f"{key}.ports")
+                    result.append(c)
             else:
                 self.check_keys(entry, key, {"from", "to"})
                 for side in ("from", "to"):
@@ -314,6 +392,7 @@ class _Loader:
                         )
                 src = self.signal(entry["from"], f"{key}.from", fmus, "output")
                 dst = self.signal(entry["to"], f"{key}.to", fmus, "input")
+                self.check_connection(Connection(src, dst), fmus, key)
                 result.append(Connection(src, dst))
         targets = [c.target for c in result]
         for t in targets:
@@ -330,24 +409,23 @@ class _Loader:
             raise self.fail(key, "expected two ports, e.g. ['train.escape_wheel', 'verge.wheel']")
         sides = []
         for port in ports:
-            if port.count(".") != 1 or port.split(".")[0] not in fmus:
+            if "." not in port or port.split(".", 1)[0] not in fmus:
                 raise self.fail(
                     key, f"expected '<instance>.<port>' with a known instance, got {port!r}"
                 )
-            instance, name = port.split(".")
-            cls = component_class(fmus[instance].fmu)
-            if name not in cls.PORTS:
-                raise self.fail(
-                    key, f"{instance!r} has no port {name!r}; expected one of {sorted(cls.PORTS)}"
-                )
-            sides.append((instance, cls, cls.PORTS[name]))
-        (ia, ca, pa), (ib, cb, pb) = sides
+            instance, name = port.split(".", 1)
+            model = fmus[instance].model
+            if name not in model.ports:
+                known = sorted(model.ports) or "none: it declares no ports, connect variables"
+                raise self.fail(key, f"{instance!r} has no port {name!r}; expected one of {known}")
+            sides.append((instance, model, model.ports[name]))
+        (ia, ma, pa), (ib, mb, pb) = sides
         roles = sorted(set(pa) & set(pb))
         if not roles:
             raise self.fail(key, f"ports {ports} share no role (angle, speed, torque, ...)")
         out = []
         for role in roles:
-            va, vb = ca.variable(pa[role]), cb.variable(pb[role])
+            va, vb = ma.variables[pa[role]], mb.variables[pb[role]]
             if va.causality == "output" and vb.causality == "input":
                 out.append(Connection((ia, va.name), (ib, vb.name)))
             elif vb.causality == "output" and va.causality == "input":
@@ -357,6 +435,27 @@ class _Loader:
                     key, f"role {role!r}: one side must output it and the other take it as input"
                 )
         return out
+
+    def check_connection(self, c: Connection, fmus: dict[str, FmuSpec], key: str) -> None:
+        """Types must match (Real to Real, Integer or Enumeration to either) and units agree
+        in dimension and scale; a side that declares no unit is accepted."""
+        (si, sv), (ti, tv) = c.source, c.target
+        src, dst = fmus[si].model.variables[sv], fmus[ti].model.variables[tv]
+        text = f"{si}.{sv} -> {ti}.{tv}"
+        if src.type not in ("Real", "Integer", "Enumeration"):
+            raise self.fail(key, f"{text}: {src.type} connections are not supported")
+        if (src.type == "Real") != (dst.type == "Real"):
+            raise self.fail(key, f"{text} joins a {src.type} output to a {dst.type} input")
+        if src.unit is None or dst.unit is None or src.unit == dst.unit:
+            return
+        a = fmus[si].model.base_unit(src.unit)
+        b = fmus[ti].model.base_unit(dst.unit)
+        if a is None or b is None:
+            raise self.fail(key, f"{text}: cannot compare units {src.unit!r} and {dst.unit!r}")
+        if a[0] != b[0] or not math.isclose(a[1], b[1], rel_tol=1e-12):
+            raise self.fail(
+                key, f"{text} joins {src.unit!r} to {dst.unit!r}: the units do not agree"
+            )
 
     def master(self, node: dict[str, Any], fmus: dict[str, FmuSpec], duration: float) -> MasterSpec:
         self.check_keys(node, "master", set(_MASTER_KEYS))
@@ -403,12 +502,16 @@ class _Loader:
             record = tuple(
                 (inst, v.name)
                 for inst, spec in fmus.items()
-                for v in component_class(spec.fmu).variables("output")
+                for v in spec.model.of("output")
+                if v.type in ("Real", "Integer", "Enumeration")
             )
         else:
             if not isinstance(record_raw, list):
                 raise self.fail("output.record", "expected a list of '<instance>.<variable>'")
             record = tuple(self.signal(s, "output.record", fmus, None) for s in record_raw)
+            for inst, var in record:
+                if fmus[inst].model.variables[var].type not in ("Real", "Integer", "Enumeration"):
+                    raise self.fail("output.record", f"{inst}.{var}: only numbers are recorded")
         every = node.get("every", 1)
         if not isinstance(every, int) or isinstance(every, bool) or every < 1:
             raise self.fail("output.every", f"expected a positive integer, got {every!r}")
@@ -434,7 +537,7 @@ class _Loader:
                 raise self.fail(
                     f"{key}.reduce", f"unknown {reduce!r}; expected one of {list(REDUCTIONS)}"
                 )
-            unit = component_class(fmus[signal[0]].fmu).variable(signal[1]).unit
+            unit = fmus[signal[0]].model.variables[signal[1]].unit or "1"
             headline[hname] = HeadlineSpec(signal, reduce, unit)
         analysis = node.get("analysis")
         if analysis is not None:
@@ -494,17 +597,16 @@ class _Loader:
 
     def swept_unit(self, dotted: str, fmus: dict[str, FmuSpec], key: str = "sweep.parameter"):
         """SI unit of a key a sweep may set (None: a plain value); fails on unknown keys."""
-        parts = dotted.split(".")
+        parts = _split_key(dotted)
         if len(parts) == 4 and parts[0] == "fmus" and parts[2] in ("parameters", "inputs"):
             instance, kind, name = parts[1], parts[2], parts[3]
             if instance not in fmus:
                 raise self.fail(key, f"unknown FMU instance {instance!r} in {dotted!r}")
-            cls = component_class(fmus[instance].fmu)
             causality = "parameter" if kind == "parameters" else "input"
-            names = [v.name for v in cls.VARIABLES if v.causality == causality]
-            if name not in names:
+            var = fmus[instance].model.variables.get(name)
+            if var is None or var.causality != causality:
                 raise self.fail(key, f"{fmus[instance].fmu} has no {causality} {name!r}")
-            return cls.variable(name).unit
+            return var.unit or "1"
         if len(parts) == 2 and parts[0] == "master" and parts[1] in _MASTER_KEYS:
             if parts[1] in _MASTER_CHOICES:
                 raise self.fail(key, f"cannot sweep {dotted!r}: it is a word, not a number")

@@ -16,7 +16,6 @@ from typing import Any
 
 import numpy as np
 
-from fmus.build import build_fmu
 from orchestrator.scenario import load_scene
 
 
@@ -64,9 +63,8 @@ def run_jobs(
     """Run ``jobs`` in parallel and return their results in job order."""
     if not jobs:
         return []
-    for job in jobs:  # build (or find cached) FMUs once, here, not in every worker
-        for spec in load_scene(job.scene, job.overrides).fmus.values():
-            build_fmu(spec.fmu)
+    for job in jobs:  # loading builds (or finds cached) FMUs: once, here, not in every worker
+        load_scene(job.scene, job.overrides)
     if dask_address:
         from dask.distributed import Client
 

@@ -38,14 +38,16 @@ class Watch:
 class CoupledSystem:
     """FMU instances in master order with their connections and recorded signals."""
 
-    def __init__(self, scene: Scene, fmu_paths: dict[str, Path]) -> None:
+    def __init__(self, scene: Scene, fmu_paths: dict[str, Path] | None = None) -> None:
+        """``fmu_paths`` (instance -> FMU file) overrides the files the scene names."""
         self.scene = scene
         self.names = list(scene.master.order)
         self.index = {n: i for i, n in enumerate(self.names)}
         self.instances: list[FmuInstance] = []
+        paths = {n: spec.path for n, spec in scene.fmus.items()} | (fmu_paths or {})
         try:
             for name in self.names:
-                self.instances.append(FmuInstance(name, fmu_paths[scene.fmus[name].fmu]))
+                self.instances.append(FmuInstance(name, paths[name]))
         except Exception:
             self.close()
             raise
@@ -95,17 +97,13 @@ class CoupledSystem:
         return kind, names.index(var)
 
     def _watch(self, i: int) -> Watch:
-        outputs = [
-            v.name
-            for v in self.instances[i].model_description.modelVariables
-            if v.causality == "output"
-        ]
-        indicators = [n for n in outputs if n.startswith("ind_")]
+        """What the FMU declares for masters to watch (nothing, for a black box)."""
+        model = self.scene.fmus[self.names[i]].model
         return Watch(
-            regime=self._slot(i, "regime")[1] if "regime" in outputs else None,
-            indicators=[self._slot(i, n)[1] for n in indicators],
-            indicator_names=indicators,
-            t_event=self._slot(i, "t_event")[1] if "t_event" in outputs else None,
+            regime=self._slot(i, model.regime)[1] if model.regime else None,
+            indicators=[self._slot(i, n)[1] for n in model.indicators],
+            indicator_names=list(model.indicators),
+            t_event=self._slot(i, model.event_time)[1] if model.event_time else None,
         )
 
     # -- life cycle -------------------------------------------------------------------

@@ -41,6 +41,8 @@ def to_si(value: object, fmi_unit: str) -> float:
     try:
         if isinstance(quantity, int | float):
             return float(quantity)
+        if quantity.unitless:  # a bare number written as text ("2.5", "nan"): taken as SI
+            return float(quantity.magnitude)
         return float(quantity.to(target).magnitude)
     except pint.DimensionalityError:
         raise ValueError(

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import pytest
@@ -10,6 +11,13 @@ PROJECT_DIR = Path(__file__).resolve().parent.parent
 SCENARIOS = PROJECT_DIR / "scenarios"
 
 
-@pytest.fixture(scope="session")
+@pytest.fixture(scope="session", autouse=True)
 def fmu_cache(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    return tmp_path_factory.mktemp("fmu_cache")
+    """The FMU cache of the session: $MECHCOSIM_FMU_CACHE if set, else a fresh one.  Set in
+    the environment, so that loading a scene (which builds its FMUs) and spawned workers
+    use it too."""
+    if os.environ.get("MECHCOSIM_FMU_CACHE"):
+        return Path(os.environ["MECHCOSIM_FMU_CACHE"])
+    path = tmp_path_factory.mktemp("fmu_cache")
+    os.environ["MECHCOSIM_FMU_CACHE"] = str(path)
+    return path

@@ -89,7 +89,10 @@ def test_outputs_written_and_metadata_complete(tmp_path, fmu_cache) -> None:
     assert summary["status"] == "completed"
     assert summary["stats"]["steps"] == 100 and summary["stats"]["do_steps"] == 200
     meta = summary["metadata"]
-    assert set(meta["fmus"]) == {"Inertia", "SpringDamperInertia"}
+    assert {k: f["model"] for k, f in meta["fmus"].items()} == {
+        "a": "Inertia",
+        "b": "SpringDamperInertia",
+    }
     assert all(len(f["sha256"]) == 64 for f in meta["fmus"].values())
     assert meta["versions"]["fmpy"] and meta["master"]["step"] == pytest.approx(1e-4)
 

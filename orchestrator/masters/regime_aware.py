@@ -30,8 +30,9 @@ from dataclasses import dataclass
 from typing import Any
 
 from orchestrator.errors import RunError
+from orchestrator.masters.fixed_step import run_jacobi
 from orchestrator.recorder import Recorder, RegimeLog, StepStats
-from orchestrator.scenario import Scene, component_class
+from orchestrator.scenario import Scene
 from orchestrator.system import CoupledSystem
 
 
@@ -81,19 +82,40 @@ class RegimeAwareMaster:
         self.log = RegimeLog(system, scene, recorder)
         # Exchanged Real signals held over a step: (instance, slot) of their sources.  Inputs
         # that are sampled as a state at the step start carry no hold error of their own.
-        # Midpoint hold: per instance, its Real inputs in feed order as (source, sampled?);
-        # the held ones are averaged over the step.
-        held = set()
+        # Midpoint hold: per instance, its Real inputs in feed order as (source, averaged?);
+        # the held ones are averaged over the step.  An FMU that does not say which of its
+        # inputs are sampled (one from another tool) is a black box: averaging a sampled
+        # input would be wrong at first order, unseen by the error test, so its inputs stay
+        # at their step-start values and their change over the step is the error (first
+        # order, as with input_hold = "start").
+        held, blind = set(), set()
         self.held_inputs: list[list[tuple[tuple[int, int], bool]]] = [[] for _ in self.names]
         for c, src in zip(scene.connections, system.connection_sources, strict=True):
             if src is None:
                 continue
-            target = component_class(scene.fmus[c.target[0]].fmu).variable(c.target[1])
-            if not target.sampled:
+            model = scene.fmus[c.target[0]].model
+            sampled = c.target[1] in model.sampled
+            if not model.annotated:
+                blind.add(src)
+            elif not sampled:
                 held.add(src)
-            self.held_inputs[system.index[c.target[0]]].append((src, target.sampled))
-        self.signals = sorted(held)
+            averaged = model.annotated and not sampled
+            self.held_inputs[system.index[c.target[0]]].append((src, averaged))
+        self.signals = sorted(held | blind)  # start hold: every held signal's change
+        self.blind = sorted(blind)
         self.scale = {s: 0.0 for s in self.signals}
+        self.first_order = not self.cfg.midpoint  # the last error ratio's order in h
+        black_boxes = sorted(
+            {c.target[0] for c in scene.connections}
+            & {n for n in self.names if not scene.fmus[n].model.annotated}
+        )
+        if black_boxes and self.cfg.midpoint:
+            stats.extra.setdefault("warnings", []).append(
+                f"FMU {', '.join(map(repr, black_boxes))} declares no sampled inputs, event "
+                "indicators or regimes: its inputs are held at the step start (first order in "
+                "the step, the step sized by their change) and its internal switches are found "
+                "only through the error test"
+            )
         # Every Real connection source: its predictor-corrector difference is the error.
         self.outputs = sorted({s for s in system.connection_sources if s is not None})
         self.out_scale = {s: 0.0 for s in self.outputs}
@@ -145,8 +167,8 @@ class RegimeAwareMaster:
         start = before.values
         for i, inputs in enumerate(self.held_inputs):
             reals = [
-                start[s][k] if sampled else 0.5 * (start[s][k] + predicted[s][k])
-                for (s, k), sampled in inputs
+                0.5 * (start[s][k] + predicted[s][k]) if averaged else start[s][k]
+                for (s, k), averaged in inputs
             ]
             system.feed(i, reals)
         self._step_all(t, h)
@@ -203,12 +225,22 @@ class RegimeAwareMaster:
                 best = t + 0.5 * h
         return best
 
-    def error_ratio(self, before: _Snapshot) -> float:
-        """Held-input error estimate relative to the tolerance (<= 1 accepts)."""
+    def step_ratio(self, before: _Snapshot) -> float:
+        """Error estimate of the step just taken, relative to the tolerance (<= 1 accepts):
+        the corrector's (second order), or the change of the signals held at the step start
+        (first order) where that is larger."""
+        if not self.cfg.midpoint:
+            return self.error_ratio(before, self.signals)
+        blind = self.error_ratio(before, self.blind) if self.blind else 0.0
+        self.first_order = blind > self.ratio
+        return max(self.ratio, blind)
+
+    def error_ratio(self, before: _Snapshot, signals: list[tuple[int, int]]) -> float:
+        """Held-input error estimate relative to the tolerance: the signals' change."""
         values = self.system.values
         worst = 0.0
         tol = self.cfg.tolerance
-        for i, k in self.signals:
+        for i, k in signals:
             a, b = before.values[i][k], values[i][k]
             scale = self.scale[(i, k)] = max(self.scale[(i, k)], abs(a), abs(b))
             if scale > 0.0:
@@ -259,7 +291,7 @@ class RegimeAwareMaster:
             t += h
             stats.steps += 1
             if te is None:
-                ratio = self.ratio if cfg.midpoint else self.error_ratio(before)
+                ratio = self.step_ratio(before)
                 stats.events += self.log_switches(t - h, before)  # switched at the start
                 recorder.row(system.record_row(t))
                 grow = 4.0 if ratio == 0.0 else min(4.0, max(0.2, self._factor(ratio)))
@@ -306,11 +338,12 @@ class RegimeAwareMaster:
                 te = self.switch_time(t, h, before)
             if te is not None:
                 if t + h - te <= cfg.event_tolerance or h <= cfg.min_step:
-                    if cfg.midpoint and self.ratio > 1.0 and h > cfg.min_step:
+                    ratio = self.step_ratio(before) if cfg.midpoint else 0.0
+                    if ratio > 1.0 and h > cfg.min_step:
                         # The step onto the switch must pass the error test as well:
                         # approach it in shorter steps (the held-input error at an impact
                         # is the speed mismatch of the two sides, hence the energy).
-                        h = max(cfg.min_step, h * max(0.2, self._factor(self.ratio)))
+                        h = max(cfg.min_step, h * max(0.2, self._factor(ratio)))
                         self._rollback(state)
                         last_ratio = None
                         continue
@@ -320,7 +353,7 @@ class RegimeAwareMaster:
                 self._rollback(state)
                 last_ratio = None
                 continue
-            ratio = self.ratio if cfg.midpoint else self.error_ratio(before)
+            ratio = self.step_ratio(before)
             if ratio > 1.0 and h > cfg.min_step:
                 # Two shrinks in a row that leave the change as large: a jump, not a smooth
                 # change (one shrink is not proof: a long step may span an oscillation).
@@ -360,7 +393,7 @@ class RegimeAwareMaster:
     def _factor(self, ratio: float) -> float:
         """Step factor for an error ratio: the held-start error estimate is first order in
         h; the predictor's error (midpoint hold) is second order in h over a step."""
-        return 0.9 / ratio if not self.cfg.midpoint else (0.8 / ratio) ** 0.5
+        return 0.9 / ratio if self.first_order else (0.8 / ratio) ** 0.5
 
     def _left_values(
         self, t: float, te: float, h: float, state: list[Any], before: _Snapshot
@@ -404,4 +437,17 @@ class RegimeAwareMaster:
 def run_regime_aware(
     system: CoupledSystem, scene: Scene, recorder: Recorder, stats: StepStats, progress
 ) -> None:
+    blind = [n for n in system.names if not scene.fmus[n].model.can_get_set_state]
+    if blind:
+        # Without rollback no trial can be taken back: say what is given up, and couple
+        # the way every tool can.
+        stats.extra.setdefault("warnings", []).append(
+            f"FMU {', '.join(map(repr, blind))} cannot save and restore its state "
+            "(canGetAndSetFMUstate is false), which the regime-aware master needs to reject "
+            "steps and to land on switches: it gives both up and runs fixed-step Jacobi at "
+            f"master.step = {scene.master.step:g} s (no error control, switches seen only "
+            "at communication points)"
+        )
+        run_jacobi(system, scene, recorder, stats, progress)
+        return
     RegimeAwareMaster(system, scene, recorder, stats).run(progress)

@@ -154,7 +154,7 @@ def lever_scene(scene: Scene) -> LeverScene:
         )
     if "lever" in options:
         name = options["lever"]
-        if name not in scene.fmus or scene.fmus[name].fmu != LEVER_FMU:
+        if name not in scene.fmus or scene.fmus[name].component != LEVER_FMU:
             levers = sorted(n for n, s in scene.fmus.items() if s.fmu == LEVER_FMU)
             raise ScenarioError(
                 scene.path, "report.options.lever", f"expected one of the levers {levers}"

@@ -96,7 +96,7 @@ class MeshScene:
 
 def mesh_scene(scene: Scene) -> MeshScene:
     """The one GearMesh of a scene; ScenarioError (file, key, expectation) when it cannot be."""
-    names = [n for n, spec in scene.fmus.items() if spec.fmu == "GearMesh"]
+    names = [n for n, spec in scene.fmus.items() if spec.component == "GearMesh"]
     if len(names) != 1:
         raise ScenarioError(scene.path, "fmus", f"expected exactly one GearMesh, found {names}")
     inst = names[0]

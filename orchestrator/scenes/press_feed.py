@@ -111,8 +111,8 @@ def feed_scene(scene: Scene) -> FeedScene:
     """The drive, clutch and load instances of a scene (exactly one of each)."""
     found: dict[str, list[str]] = {"CrankCouplerDrive": [], "SpragClutch": [], "BrakeLoad": []}
     for name, spec in scene.fmus.items():
-        if spec.fmu in found:
-            found[spec.fmu].append(name)
+        if spec.component in found:
+            found[spec.component].append(name)
     for fmu, names in found.items():
         if len(names) != 1:
             raise ValueError(f"press feed scene {scene.name}: needs one {fmu}, found {names}")

@@ -1,0 +1,738 @@
+"""The documentation every FMU carries: ``documentation/index.html``, FMI 2.0's entry point.
+
+``render_documentation`` writes one self-contained HTML5 page (inline CSS, no scripts, no
+external resources) from what the project already states once: the component's docstrings
+(which cite the source documents), its VARIABLES and PORTS tables, its regime names, the
+wrapper script's description, and the example scenes of the registry entry, read from the
+project's ``scenarios/`` at build time.  The page tells a user of another tool (FMPy,
+libcosim, a C/C++ master) what the FMU models, how to couple it, and what its host needs.
+"""
+
+from __future__ import annotations
+
+import ast
+import importlib
+import inspect
+import re
+import shlex
+import sys
+import textwrap
+import tomllib
+from dataclasses import dataclass
+from html import escape
+from pathlib import Path
+from typing import Any
+
+from components.base import COMMON_OUTPUTS, Component
+from fmus.description import EVENT_TIME, INDICATOR_PREFIX, REGIME
+from fmus.registry import FMU_WRAPPERS, FmuWrapper
+
+PROJECT_DIR = Path(__file__).resolve().parent.parent
+#: Outputs every component shares (energy bookkeeping): poor examples of what one computes.
+_COMMON = {v.name for v in COMMON_OUTPUTS} | {"external_work"}
+#: What the slave class uses when a wrapper script sets no ``default_run``.
+_DEFAULT_RUN = (0.0, 1.0, 1.0e-3)
+SAMPLED_NOTE = (
+    "sampled: the value is taken as a state at the start of each step, not a signal held "
+    "over the step; a master should not average it"
+)
+PORT_RULE = (
+    "Connecting two ports joins each role present on both sides, from the side where it is "
+    "an output to the side where it is an input. A role present on one side only is not "
+    "connected."
+)
+
+
+class DocumentationError(RuntimeError):
+    """The documentation cannot be written (a missing example scene, a broken connection)."""
+
+
+# -- public entry point ---------------------------------------------------------------------
+def render_documentation(
+    wrapper: FmuWrapper, component_class: type[Component], requirements: list[str]
+) -> str:
+    """The FMU's ``documentation/index.html``: a complete, standalone HTML5 page."""
+    slave = _slave_metadata(wrapper.script)
+    description = (slave.description or _first_line(component_class.__doc__)).rstrip(".")
+    examples = [_read_example(wrapper, path) for path in wrapper.examples]
+    title = f"{wrapper.name}: FMU documentation"
+    sections = [
+        ("model", "What it models", _model_section(wrapper, component_class, description)),
+        ("ports", "Ports", _ports_section(component_class)),
+        ("variables", "Variables", _variables_section(component_class)),
+        ("regimes", "Regimes and events", _regimes_section(wrapper, component_class)),
+        ("coupling", "How to couple it", _coupling_section(wrapper, examples)),
+        ("host", "Host requirements", _host_section(wrapper, requirements)),
+        ("tools", "Usage in other tools", _tools_section(wrapper, component_class, slave)),
+        ("capabilities", "FMI capabilities", _capabilities_section()),
+    ]
+    toc = "".join(f'<li><a href="#{key}">{escape(head)}</a></li>' for key, head, _ in sections)
+    body = "".join(
+        f'<section id="{key}">\n<h2>{escape(head)}</h2>\n{html}</section>\n'
+        for key, head, html in sections
+    )
+    return (
+        "<!DOCTYPE html>\n"
+        '<html lang="en">\n<head>\n<meta charset="utf-8">\n'
+        '<meta name="viewport" content="width=device-width, initial-scale=1">\n'
+        f"<title>{escape(title)}</title>\n<style>{_CSS}</style>\n</head>\n<body>\n"
+        f"<header>\n<h1>{escape(wrapper.name)}</h1>\n"
+        f'<p class="lead">{escape(description)}</p>\n'
+        "<dl>"
+        f"<dt>Model identifier</dt><dd><code>{escape(wrapper.name)}</code></dd>"
+        "<dt>Standard</dt><dd>FMI 2.0, co-simulation</dd>"
+        f"<dt>Component</dt><dd><code>{escape(wrapper.component)}</code> "
+        "(plain Python, wrapped by a generic pythonfmu slave)</dd>"
+        "</dl>\n</header>\n"
+        f'<nav>\n<h2>Contents</h2>\n<ol class="toc">{toc}</ol>\n</nav>\n'
+        f"<main>\n{body}</main>\n"
+        "<footer><p>Generated at build time from the component's declarations, docstrings "
+        "and example scenes.</p></footer>\n"
+        "</body>\n</html>\n"
+    )
+
+
+# -- the wrapper script, read without importing it ------------------------------------------
+@dataclass(frozen=True)
+class _SlaveMetadata:
+    description: str
+    default_run: tuple[float, float, float]
+
+
+def _slave_metadata(script: Path) -> _SlaveMetadata:
+    """``description`` and ``default_run`` of the script's slave class.
+
+    Parsed, not imported: the script imports ``component_slave``, which exists as a
+    top-level module only inside a built FMU.
+    """
+    tree = ast.parse(script.read_text(), filename=str(script))
+    for node in tree.body:
+        if not isinstance(node, ast.ClassDef):
+            continue
+        if not any(_base_name(b) == "ComponentSlave" for b in node.bases):
+            continue
+        found: dict[str, Any] = {}
+        for stmt in node.body:
+            if isinstance(stmt, ast.Assign):
+                targets, value = stmt.targets, stmt.value
+            elif isinstance(stmt, ast.AnnAssign) and stmt.value is not None:
+                targets, value = [stmt.target], stmt.value
+            else:
+                continue
+            for target in targets:
+                if isinstance(target, ast.Name) and target.id in ("description", "default_run"):
+                    try:
+                        found[target.id] = ast.literal_eval(value)
+                    except ValueError:
+                        raise DocumentationError(
+                            f"{script}: {target.id} of {node.name} is not a literal"
+                        ) from None
+        run = tuple(float(x) for x in found.get("default_run", _DEFAULT_RUN))
+        if len(run) != 3:
+            raise DocumentationError(f"{script}: default_run must be (start, stop, step)")
+        return _SlaveMetadata(str(found.get("description", "")), (run[0], run[1], run[2]))
+    raise DocumentationError(f"{script}: no subclass of ComponentSlave")
+
+
+def _base_name(node: ast.expr) -> str:
+    if isinstance(node, ast.Name):
+        return node.id
+    if isinstance(node, ast.Attribute):
+        return node.attr
+    return ""
+
+
+def _first_line(doc: str | None) -> str:
+    return inspect.cleandoc(doc or "").split("\n", 1)[0]
+
+
+# -- docstrings as HTML -----------------------------------------------------------------------
+_BULLET = re.compile(r"^(?:([*-])|(\d+)\.)\s+(.*)$")
+_LITERAL = re.compile(r"``(.+?)``|`([^`\s][^`]*?)`")
+_EMPHASIS = re.compile(r"(?<![\w*])\*([A-Za-z](?:[A-Za-z -]*[A-Za-z])?)\*(?![\w*])")
+
+
+def _inline(text: str) -> str:
+    """Escape ``text``; ``literals`` become code, *words* emphasis (reST-like docstrings)."""
+    out, last = [], 0
+    for m in _LITERAL.finditer(text):
+        out.append(_EMPHASIS.sub(r"<em>\1</em>", escape(text[last : m.start()])))
+        out.append(f"<code>{escape(m.group(1) or m.group(2))}</code>")
+        last = m.end()
+    out.append(_EMPHASIS.sub(r"<em>\1</em>", escape(text[last:])))
+    return "".join(out)
+
+
+def docstring_html(doc: str | None) -> str:
+    """A docstring as paragraphs, bullet or numbered lists and preformatted blocks.
+
+    Indented lines that do not continue a list item are equations or tables: they keep
+    their layout in a ``<pre>``.
+    """
+    text = inspect.cleandoc(doc or "")
+    html: list[str] = []
+    for block in re.split(r"\n[ \t]*\n", text):
+        html.extend(_block_html(block.splitlines()))
+    return "\n".join(html) + "\n" if html else ""
+
+
+def _block_html(lines: list[str]) -> list[str]:
+    out: list[str] = []
+    para: list[str] = []
+    pre: list[str] = []
+    items: list[tuple[str | None, str]] = []  # (number, text); number None: a bullet
+    numbered = False
+
+    def flush() -> None:
+        nonlocal numbered
+        if para:
+            out.append(f"<p>{_inline(' '.join(para))}</p>")
+            para.clear()
+        if pre:
+            out.append(f"<pre>{escape(textwrap.dedent(chr(10).join(pre)))}</pre>")
+            pre.clear()
+        if items:
+            tag = "ol" if numbered else "ul"
+            lis = "".join(
+                f'<li value="{n}">{_inline(t)}</li>' if n is not None else f"<li>{_inline(t)}</li>"
+                for n, t in items
+            )
+            out.append(f"<{tag}>{lis}</{tag}>")
+            items.clear()
+            numbered = False
+
+    for line in lines:
+        indent = len(line) - len(line.lstrip())
+        bullet = _BULLET.match(line) if indent == 0 else None
+        if bullet:
+            if para or pre or (items and numbered != (bullet.group(2) is not None)):
+                flush()
+            numbered = bullet.group(2) is not None
+            items.append((bullet.group(2), bullet.group(3).strip()))
+        elif indent > 0 and items and not pre:
+            number, item = items[-1]
+            items[-1] = (number, f"{item} {line.strip()}")
+        elif indent > 0:
+            if para or items:
+                flush()
+            pre.append(line)
+        else:
+            if pre or items:
+                flush()
+            para.append(line.strip())
+    flush()
+    return out
+
+
+# -- sections -----------------------------------------------------------------------------------
+def _model_section(wrapper: FmuWrapper, cls: type[Component], description: str) -> str:
+    module = sys.modules[cls.__module__]
+    return (
+        f"<p><strong>{escape(wrapper.name)}</strong>: {escape(description)}.</p>\n"
+        "<p>The sources (reports, equations, tables, pages) are cited in the component's own "
+        "documentation, reproduced here.</p>\n"
+        f"<h3>Module <code>{escape(cls.__module__)}</code></h3>\n"
+        f'<div class="doc">\n{docstring_html(module.__doc__)}</div>\n'
+        f"<h3>Class <code>{escape(cls.__name__)}</code></h3>\n"
+        f'<div class="doc">\n{docstring_html(cls.__doc__)}</div>\n'
+    )
+
+
+def _ports_section(cls: type[Component]) -> str:
+    if not cls.PORTS:
+        return (
+            "<p>This FMU has no rotational ports: connect its variables one by one "
+            '(see <a href="#variables">Variables</a>).</p>\n'
+        )
+    parts = [
+        "<p>A port groups the variables of one shaft or joint by <em>role</em> (angle, "
+        "speed, torque, and extra roles some joints need). "
+        f"{escape(PORT_RULE)}</p>\n"
+    ]
+    for port, roles in cls.PORTS.items():
+        rows = []
+        for role, name in roles.items():
+            var = cls.variable(name)
+            direction = {"output": "out", "input": "in"}.get(var.causality, var.causality)
+            note = f' <span class="tag">{escape(SAMPLED_NOTE)}</span>' if var.sampled else ""
+            rows.append(
+                '<tr class="role">'
+                f"<td><code>{escape(role)}</code></td><td><code>{escape(name)}</code></td>"
+                f"<td>{escape(var.causality)} ({direction})</td><td>{escape(var.type)}</td>"
+                f"<td>{escape(var.unit)}</td><td>{escape(var.description)}{note}</td></tr>"
+            )
+        parts.append(
+            f"<h3>Port <code>{escape(port)}</code></h3>\n"
+            f'<table id="port-{escape(port)}">\n'
+            "<thead><tr><th>role</th><th>variable</th><th>causality (direction)</th>"
+            "<th>type</th><th>unit</th><th>description</th></tr></thead>\n"
+            f"<tbody>\n{chr(10).join(rows)}\n</tbody>\n</table>\n"
+        )
+    return "".join(parts)
+
+
+def _variables_section(cls: type[Component]) -> str:
+    names = getattr(cls, "REGIME_NAMES", {})
+    rows = []
+    for var in cls.VARIABLES:
+        notes = []
+        if var.causality == "input" and var.sampled:
+            notes.append(f'<span class="tag">{escape(SAMPLED_NOTE)}</span>')
+        if var.causality == "output":
+            deps = ", ".join(f"<code>{escape(d)}</code>" for d in var.depends_on) or "none"
+            notes.append(f"direct feedthrough from: {deps}")
+        vtype = "Enumeration" if var.name == REGIME and names else var.type
+        rows.append(
+            f'<tr class="variable" id="var-{escape(var.name)}">'
+            f"<td><code>{escape(var.name)}</code></td><td>{escape(var.causality)}</td>"
+            f"<td>{vtype}</td><td>{escape(var.unit)}</td>"
+            f'<td class="num">{escape(_number(var.start, var.type))}</td>'
+            f'<td class="num">{escape(_number(var.min, var.type))}</td>'
+            f'<td class="num">{escape(_number(var.max, var.type))}</td>'
+            f"<td>{escape(var.description)}</td><td>{'<br>'.join(notes)}</td></tr>"
+        )
+    n = {c: sum(v.causality == c for v in cls.VARIABLES) for c in ("parameter", "input", "output")}
+    return (
+        f"<p>{n['parameter']} parameters, {n['input']} inputs, {n['output']} outputs, in the "
+        "order of the model description. Values are SI in the unit shown (an FMI unit name; "
+        "<code>1</code>: dimensionless or a count). Min and max are blank where there is "
+        "no bound.</p>\n"
+        "<ul>\n"
+        f"<li><em>Sampled</em> inputs: {escape(SAMPLED_NOTE)}. Other inputs are signals "
+        "held constant over a step (zero-order hold).</li>\n"
+        "<li><em>Direct feedthrough</em>: the inputs an output depends on within one instant "
+        "(set an input, read the output, no step between); <em>none</em>: the output "
+        "changes only by stepping, so it never closes an algebraic loop.</li>\n"
+        "</ul>\n"
+        '<table id="variables-table">\n'
+        "<thead><tr><th>name</th><th>causality</th><th>type</th><th>unit</th><th>start</th>"
+        "<th>min</th><th>max</th><th>description</th><th>notes</th></tr></thead>\n"
+        f"<tbody>\n{chr(10).join(rows)}\n</tbody>\n</table>\n"
+    )
+
+
+def _regimes_section(wrapper: FmuWrapper, cls: type[Component]) -> str:
+    names: dict[int, str] = getattr(cls, "REGIME_NAMES", {})
+    outputs = cls.variables("output")
+    parts = []
+    if names:
+        rows = "".join(
+            f'<tr class="regime"><td class="num">{code}</td><td>{escape(name)}</td></tr>'
+            for code, name in sorted(names.items())
+        )
+        parts.append(
+            f"<p>The output <code>{REGIME}</code> gives the regime (mode) the component is "
+            "in. In the model description it is an Enumeration (type "
+            f"<code>{escape(wrapper.name)}.Regime</code>) whose items are these names; read "
+            "it as an Integer (fmi2GetInteger).</p>\n"
+            '<table id="regimes">\n<thead><tr><th>code</th><th>regime</th></tr></thead>\n'
+            f"<tbody>{rows}</tbody>\n</table>\n"
+        )
+    elif any(v.name == REGIME for v in outputs):
+        parts.append(
+            f"<p>The output <code>{REGIME}</code> is an Integer; this component names no "
+            "regimes (it has one mode).</p>\n"
+        )
+    indicators = [v for v in outputs if v.name.startswith(INDICATOR_PREFIX)]
+    if indicators:
+        items = "".join(
+            f'<li class="indicator"><code>{escape(v.name)}</code> [{escape(v.unit)}]: '
+            f"{escape(v.description)}</li>"
+            for v in indicators
+        )
+        parts.append(
+            "<p>Event indicators (outputs named <code>ind_*</code>): a regime switch happens "
+            "where one crosses zero. A master that steps past a switch sees the sign change "
+            f"and can locate it.</p>\n<ul>{items}</ul>\n"
+        )
+    else:
+        parts.append("<p>This FMU declares no event indicator outputs (<code>ind_*</code>).</p>\n")
+    event = next((v for v in outputs if v.name == EVENT_TIME), None)
+    if event is not None:
+        parts.append(
+            f"<p><code>{EVENT_TIME}</code> [s] ({escape(event.description)}): the time of the "
+            "last internal event the FMU located inside a step (start value "
+            f"{escape(_number(event.start, event.type))}: none yet), so that a master can "
+            "land on it: restore the state saved at the step start (fmi2SetFMUstate) and "
+            f"retake the step with length <code>{EVENT_TIME} - t</code>.</p>\n"
+        )
+    return "".join(parts)
+
+
+def _coupling_section(wrapper: FmuWrapper, examples: list[_Example]) -> str:
+    rule = (
+        '<p>Ports connect by the rule of <a href="#ports">Ports</a>; a single signal '
+        "connects one output to one input of the same type and unit (each input driven by "
+        "one output at most).</p>\n"
+    )
+    if not examples:
+        return rule + (
+            "<p>No scene of the project couples this FMU with another FMU (the scenes that "
+            "use it run it alone): drive its inputs from any outputs of the same type and "
+            'unit, or set them as start values (see <a href="#tools">Usage in other '
+            "tools</a>).</p>\n"
+        )
+    intro = (
+        "<p>The scenes below, from the project's <code>scenarios/</code>, are worked "
+        "couplings of this FMU, every connection spelled out variable by variable as "
+        "another tool needs it. Parameter values are as the scene writes them: a value "
+        "with a unit must be converted to the SI unit shown before it is set on the FMU; a "
+        "bare number is already SI.</p>\n"
+    )
+    return rule + intro + "".join(_example_html(wrapper, ex) for ex in examples)
+
+
+def _host_section(wrapper: FmuWrapper, requirements: list[str]) -> str:
+    if requirements:
+        reqs = "".join(f"<li><code>{escape(r)}</code></li>" for r in requirements)
+        reqs = f"<ul>{reqs}</ul>\n"
+        install = " ".join(shlex.quote(r) for r in requirements)
+        install_cmd = f"python3 -m pip install {install}"
+    else:
+        reqs = "<p>No packages beyond the standard library.</p>\n"
+        install_cmd = ""
+    fmu = f"{wrapper.name}.fmu"
+    libdir = (
+        "python3 -c \"import sysconfig; print(sysconfig.get_config_var('LIBDIR'), "
+        "sysconfig.get_config_var('LDLIBRARY'))\""
+    )
+    return (
+        "<p>The FMU's binary is pythonfmu's runtime: it runs the FMU's Python code "
+        "(packed in <code>resources/</code>) in the Python interpreter of the host "
+        "process. It needs <strong>Python 3.11 or later</strong> with these packages, "
+        "installed into the Python that the host loads:</p>\n"
+        f"{reqs}"
+        + (f"<pre>{escape(install_cmd)}</pre>\n" if install_cmd else "")
+        + "<p>The same list is packed as <code>resources/requirements.txt</code>; "
+        f"<code>pythonfmu deploy -f {escape(fmu)}</code>, run with that Python, installs "
+        "it.</p>\n"
+        "<ul>\n"
+        "<li><strong>Python hosts</strong> (FMPy, libcosimpy, a Python master): the "
+        "interpreter is already loaded; install the packages into that same "
+        "environment.</li>\n"
+        "<li><strong>Non-Python hosts</strong> (libcosim's <code>cosim</code> command line, "
+        "a C/C++ tool): the binary does not link libpython itself, so libpython must be "
+        "loadable in the host process. On Linux preload it, e.g. "
+        "<code>LD_PRELOAD=/path/to/libpython3.11.so</code>; this prints where it is:"
+        f"<pre>{escape(libdir)}</pre>"
+        "The packages must then be installed in that Python (for a virtual environment, "
+        "add its <code>site-packages</code> to <code>PYTHONPATH</code>).</li>\n"
+        "<li>A missing module is reported in the FMU's log (fmi2Error) when the FMU is "
+        "instantiated, with the interpreter that ran it; instantiation then fails.</li>\n"
+        "</ul>\n"
+    )
+
+
+def _tools_section(wrapper: FmuWrapper, cls: type[Component], slave: _SlaveMetadata) -> str:
+    fmu = f"{wrapper.name}.fmu"
+    start, stop, step = slave.default_run
+    params = cls.variables("parameter")[:2]
+    # The first output of the component's own (the energy outputs every component shares
+    # say little about it), and the regime.
+    own = [v.name for v in cls.variables("output") if v.name not in _COMMON]
+    outputs = own[:1] + [REGIME] if any(v.name == REGIME for v in cls.VARIABLES) else own[:2]
+    start_values = " ".join(f"{v.name} {_number(v.start, v.type)}" for v in params)
+    sv_opt = f" --start-values {start_values}" if params else ""
+    simulate = (
+        f"fmpy simulate {fmu}{sv_opt} --start-time {_g(start)} --stop-time {_g(stop)} "
+        f"--step-size {_g(step)} --output-variables {' '.join(outputs)} "
+        f"--output-file {wrapper.name}.csv"
+    )
+    py_values = ", ".join(f'"{v.name}": {_number(v.start, v.type)}' for v in params)
+    out_list = ", ".join(f'"{o}"' for o in outputs)
+    snippet = "\n".join(
+        [
+            "from fmpy import simulate_fmu",
+            f"start_values = {{{py_values}}}  # SI units of the variables table",
+            f'result = simulate_fmu("{fmu}", start_time={_g(start)}, stop_time={_g(stop)}, '
+            f"step_size={_g(step)},",
+            f"                      start_values=start_values, output=[{out_list}])",
+            "for name in result.dtype.names:",
+            "    print(name, result[name][-1])",
+        ]
+    )
+    cosim_values = " ".join(f"{v.name}={_number(v.start, v.type)}" for v in params)
+    cosim = (
+        f"LD_PRELOAD=/path/to/libpython3.11.so cosim run-single {fmu} {cosim_values} "
+        f"-b {_g(start)} -d {_g(stop - start)} -s {_g(step)} --output-file {wrapper.name}.csv"
+    )
+    libcosim = "\n".join(
+        [
+            "from libcosimpy.CosimExecution import CosimExecution",
+            "from libcosimpy.CosimSlave import CosimLocalSlave",
+            "",
+            f"execution = CosimExecution.from_step_size(step_size={round(step * 1e9)})  # ns",
+            f'index = execution.add_local_slave(CosimLocalSlave(fmu_path="{fmu}", '
+            f'instance_name="{wrapper.name.lower()}"))',
+            "vr = {v.name.decode(): v.reference for v in execution.slave_variables(index)}",
+            "# per connection: connect_real_variables(out_index, out_vr, in_index, in_vr),",
+            "# connect_integer_variables(...) for an Integer connection",
+            f"execution.simulate_until(target_time={round((stop - start) * 1e9)})  # ns",
+        ]
+    )
+    return (
+        f"<p>Below, <code>{escape(fmu)}</code> is the FMU file. Run alone, the FMU uses "
+        f"its default experiment: start {_g(start)} s, stop {_g(stop)} s, step "
+        f"{_g(step)} s. Start values are SI (variables table); any parameter or input can "
+        "be set by name.</p>\n"
+        "<h3>FMPy</h3>\n"
+        f"<pre>fmpy info {escape(fmu)}\nfmpy validate {escape(fmu)}\n{escape(simulate)}</pre>\n"
+        "<p>From Python:</p>\n"
+        f"<pre>{escape(snippet)}</pre>\n"
+        "<h3>libcosim</h3>\n"
+        "<p>libcosimpy (a Python host: nothing to preload) adds each FMU with "
+        "<code>CosimExecution.from_step_size</code> (step in integer nanoseconds) and "
+        "<code>add_local_slave</code>, finds value references by name through "
+        "<code>slave_variables</code>, and joins the connections of "
+        '<a href="#coupling">How to couple it</a> with '
+        "<code>connect_real_variables</code>, or <code>connect_integer_variables</code> for "
+        "the Integer ones. Run each execution in a process of its own: libcosim unloads the "
+        "FMU binary when it is done, and pythonfmu's runtime cannot be loaded again in the "
+        "same process.</p>\n"
+        f"<pre>{escape(libcosim)}</pre>\n"
+        "<p>The <code>cosim</code> command line (a non-Python host, see "
+        '<a href="#host">Host requirements</a>):</p>\n'
+        f"<pre>cosim inspect {escape(fmu)}\n{escape(cosim)}</pre>\n"
+    )
+
+
+def _capabilities_section() -> str:
+    return (
+        "<ul>\n"
+        "<li>FMI 2.0 <strong>co-simulation</strong> only (no model exchange); variable "
+        "communication step sizes; inputs are held constant over a step (no input "
+        "derivatives or interpolation).</li>\n"
+        "<li><strong>canGetAndSetFMUstate</strong>: fmi2GetFMUstate saves the complete state, "
+        "hidden variables and the regime included, so restoring it and stepping again "
+        "reproduces the same numbers bit for bit; a state can be restored any number of "
+        "times. The state cannot be serialized (canSerializeFMUstate is false).</li>\n"
+        "<li>A step size that is not positive or not finite, a non-finite time, or a "
+        "non-finite value set on a Real is rejected with <strong>fmi2Error</strong>, the "
+        "reason in the FMU's log. A step the component cannot complete returns fmi2Error "
+        "too, with the reason logged.</li>\n"
+        "<li>Outputs are valid in initialization mode: a master may read them there to set "
+        "consistent inputs.</li>\n"
+        "</ul>\n"
+    )
+
+
+# -- example scenes ---------------------------------------------------------------------------
+@dataclass(frozen=True)
+class _Connection:
+    source: tuple[str, str]  # (instance, variable), an output
+    target: tuple[str, str]  # (instance, variable), an input
+    type: str  # "Real" or "Integer"
+    via: str  # the scene entry it comes from
+
+
+@dataclass(frozen=True)
+class _Example:
+    path: str
+    scene: dict[str, Any]
+    instances: dict[str, str]  # instance -> FMU model identifier
+    classes: dict[str, type[Component]]
+    connections: list[_Connection]
+
+
+def _read_example(wrapper: FmuWrapper, path: str) -> _Example:
+    file = PROJECT_DIR / path
+    if not file.is_file():
+        raise DocumentationError(
+            f"{wrapper.name}: example scene {path} (fmus/registry.py) does not exist "
+            f"in {PROJECT_DIR}"
+        )
+    try:
+        scene = tomllib.loads(file.read_text())
+    except tomllib.TOMLDecodeError as exc:
+        raise DocumentationError(f"{path}: not valid TOML: {exc}") from None
+    instances: dict[str, str] = {}
+    classes: dict[str, type[Component]] = {}
+    for instance, spec in scene.get("fmus", {}).items():
+        model = spec.get("component") if isinstance(spec, dict) else None
+        if model not in FMU_WRAPPERS:
+            raise DocumentationError(f"{path}: fmus.{instance}: unknown component {model!r}")
+        instances[instance] = model
+        classes[instance] = _component_class(FMU_WRAPPERS[model])
+    if wrapper.name not in instances.values():
+        raise DocumentationError(
+            f"{path}: no instance of {wrapper.name}, yet listed as its example"
+        )
+    connections = [
+        c
+        for i, entry in enumerate(scene.get("connections", []))
+        for c in _expand(path, i, entry, classes)
+    ]
+    return _Example(path, scene, instances, classes, connections)
+
+
+def _component_class(wrapper: FmuWrapper) -> type[Component]:
+    module, name = wrapper.component.rsplit(".", 1)
+    return getattr(importlib.import_module(module), name)
+
+
+def _expand(
+    path: str, i: int, entry: dict[str, Any], classes: dict[str, type[Component]]
+) -> list[_Connection]:
+    """One ``[[connections]]`` entry as variable-level connections (the port rule)."""
+    key = f"{path}: connections[{i}]"
+    if "ports" in entry:
+        (ia, pa), (ib, pb) = (_split(key, p, classes) for p in entry["ports"])
+        ca, cb = classes[ia], classes[ib]
+        if pa not in ca.PORTS or pb not in cb.PORTS:
+            raise DocumentationError(f"{key}: unknown port in {entry['ports']}")
+        roles_a, roles_b = ca.PORTS[pa], cb.PORTS[pb]
+        via = f"{ia}.{pa} \u2194 {ib}.{pb}"
+        out = []
+        for role in (r for r in roles_a if r in roles_b):
+            va, vb = ca.variable(roles_a[role]), cb.variable(roles_b[role])
+            if va.causality == "output" and vb.causality == "input":
+                out.append(_Connection((ia, va.name), (ib, vb.name), va.type, f"{via}: {role}"))
+            elif vb.causality == "output" and va.causality == "input":
+                out.append(_Connection((ib, vb.name), (ia, va.name), vb.type, f"{via}: {role}"))
+            else:
+                raise DocumentationError(f"{key}: role {role!r} is not output on one side only")
+        return out
+    if "from" not in entry or "to" not in entry:
+        raise DocumentationError(f"{key}: expected 'ports' or 'from' and 'to'")
+    src = _split(key, entry["from"], classes)
+    dst = _split(key, entry["to"], classes)
+    var = classes[src[0]].variable(src[1])
+    return [_Connection(src, dst, var.type, "signal")]
+
+
+def _split(key: str, ref: str, classes: dict[str, type[Component]]) -> tuple[str, str]:
+    instance, _, name = ref.partition(".")
+    if instance not in classes or not name:
+        raise DocumentationError(f"{key}: {ref!r} is not '<instance>.<name>' of a known instance")
+    return instance, name
+
+
+def _example_html(wrapper: FmuWrapper, ex: _Example) -> str:
+    scene = ex.scene.get("scene", {})
+    master = ex.scene.get("master", {})
+    stem = Path(ex.path).stem
+    head = f"<h3>Scene <code>{escape(ex.path)}</code></h3>\n"
+    if scene.get("description"):
+        head += f"<p>{escape(str(scene['description']))}.</p>\n"
+    settings = [f"{k} = {_toml(master[k])}" for k in ("algorithm", "step") if k in master]
+    settings += [f"stop = {_toml(scene['stop'])}"] if "stop" in scene else []
+    if settings:
+        head += f"<p>Master in the scene: <code>{escape(', '.join(settings))}</code>.</p>\n"
+    inst_rows = "".join(
+        f"<tr><td><code>{escape(inst)}</code></td><td><code>{escape(model)}</code>"
+        + (" (this FMU)" if model == wrapper.name else "")
+        + "</td></tr>"
+        for inst, model in ex.instances.items()
+    )
+    conn_rows = []
+    for n, c in enumerate(ex.connections, start=1):
+        integer = c.type == "Integer"
+        kind = (
+            '<strong class="integer">Integer</strong>: connect it as an Integer'
+            if integer
+            else "Real"
+        )
+        conn_rows.append(
+            f'<tr class="connection{" integer" if integer else ""}"><td class="num">{n}</td>'
+            f"<td><code>{escape('.'.join(c.source))} -&gt; {escape('.'.join(c.target))}</code>"
+            f"</td><td>{kind}</td><td>{escape(c.via)}</td></tr>"
+        )
+    n_int = sum(c.type == "Integer" for c in ex.connections)
+    int_note = (
+        f"<p>{n_int} of them {'is an Integer' if n_int == 1 else 'are Integers'}: an FMI tool "
+        "must connect it as an Integer (fmi2GetInteger / fmi2SetInteger; libcosimpy "
+        "<code>connect_integer_variables</code>), not as a Real.</p>\n"
+        if n_int
+        else ""
+    )
+    value_rows = []
+    for inst, spec in ex.scene.get("fmus", {}).items():
+        cls = ex.classes[inst]
+        for kind in ("parameters", "inputs"):
+            for name, value in spec.get(kind, {}).items():
+                try:
+                    unit = cls.variable(name).unit
+                except KeyError:
+                    raise DocumentationError(
+                        f"{ex.path}: fmus.{inst}.{kind}: {cls.__name__} has no {name!r}"
+                    ) from None
+                value_rows.append(
+                    f"<tr><td><code>{escape(inst)}</code></td><td>{kind[:-1]}</td>"
+                    f"<td><code>{escape(name)}</code></td>"
+                    f"<td><code>{escape(_toml(value))}</code></td><td>{escape(unit)}</td></tr>"
+                )
+    values = (
+        '<table class="values">\n<thead><tr><th>instance</th><th>kind</th><th>variable</th>'
+        "<th>value as written</th><th>FMU unit (SI)</th></tr></thead>\n"
+        f"<tbody>{''.join(value_rows)}</tbody>\n</table>\n"
+        if value_rows
+        else "<p>The scene sets no parameter: every FMU runs with its start values.</p>\n"
+    )
+    return (
+        head + '<table class="instances">\n<thead><tr><th>instance</th><th>FMU model</th></tr>'
+        f"</thead>\n<tbody>{inst_rows}</tbody>\n</table>\n"
+        f"<p>{len(ex.connections)} variable-level connections (output -&gt; input):</p>\n"
+        f'<table id="connections-{escape(stem)}" class="connections">\n'
+        "<thead><tr><th>#</th><th>connection</th><th>type</th><th>from scene entry</th></tr>"
+        f"</thead>\n<tbody>\n{chr(10).join(conn_rows)}\n</tbody>\n</table>\n"
+        f"{int_note}"
+        "<p>Values the scene sets (parameters, and start values of inputs):</p>\n"
+        f"{values}"
+    )
+
+
+# -- formatting ---------------------------------------------------------------------------------
+def _number(value: float | None, vtype: str) -> str:
+    if value is None:
+        return ""
+    if vtype == "Integer":
+        return str(int(value))
+    return repr(float(value))
+
+
+def _g(value: float) -> str:
+    return repr(float(value))
+
+
+def _toml(value: Any) -> str:
+    """A TOML value as the scene writes it."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, str):
+        return '"' + value.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    if isinstance(value, dict):
+        return "{ " + ", ".join(f"{k} = {_toml(v)}" for k, v in value.items()) + " }"
+    if isinstance(value, list):
+        return "[" + ", ".join(_toml(v) for v in value) + "]"
+    return repr(value)
+
+
+_CSS = """
+body { font-family: system-ui, -apple-system, "Segoe UI", Roboto, sans-serif; line-height: 1.45;
+  max-width: 72rem; margin: 0 auto; padding: 1rem 1.5rem 3rem; color: #1b1f23; }
+h1 { margin-bottom: 0.2rem; }
+h2 { border-bottom: 1px solid #d0d7de; padding-bottom: 0.2rem; margin-top: 2rem; }
+h3 { margin-top: 1.4rem; }
+.lead { font-size: 1.15rem; color: #444; margin-top: 0; }
+dl { display: grid; grid-template-columns: max-content auto; gap: 0.2rem 1rem; }
+dt { font-weight: 600; }
+dd { margin: 0; }
+code, pre { font-family: ui-monospace, SFMono-Regular, Menlo, Consolas, monospace;
+  font-size: 0.9em; }
+code { background: #f3f4f6; padding: 0 0.2em; border-radius: 3px; }
+pre { background: #f6f8fa; border: 1px solid #d0d7de; border-radius: 4px; padding: 0.6rem;
+  white-space: pre-wrap; overflow-wrap: anywhere; }
+pre code { background: none; padding: 0; }
+.doc { border-left: 3px solid #d0d7de; padding-left: 1rem; }
+table { border-collapse: collapse; margin: 0.6rem 0 1rem; width: 100%; font-size: 0.92rem; }
+th, td { border: 1px solid #d0d7de; padding: 0.25rem 0.5rem; text-align: left;
+  vertical-align: top; }
+th { background: #f6f8fa; }
+td.num { text-align: right; font-variant-numeric: tabular-nums; white-space: nowrap; }
+tr.integer td { background: #fff8e1; }
+.tag { display: inline-block; font-size: 0.85em; color: #7a4b00; background: #fff4d6;
+  border-radius: 3px; padding: 0 0.3em; }
+.toc { columns: 2; }
+footer { margin-top: 3rem; color: #666; font-size: 0.85rem; }
+@media print { pre { white-space: pre-wrap; } nav { display: none; } }
+"""

@@ -1,0 +1,253 @@
+"""Every FMU's documentation/index.html: standalone, complete, and true to the project."""
+
+from __future__ import annotations
+
+import dataclasses
+import re
+import tomllib
+from functools import cache
+from html.parser import HTMLParser
+from pathlib import Path
+
+import pytest
+
+from fmus.documentation import DocumentationError, docstring_html, render_documentation
+from fmus.registry import FMU_WRAPPERS
+from orchestrator.scenario import component_class
+
+PROJECT_DIR = Path(__file__).resolve().parent.parent
+
+NAMES = sorted(FMU_WRAPPERS)
+REQUIREMENTS = ["numpy>=1.26", "scipy>=1.11"]
+_VOID = {"br", "hr", "img", "input", "link", "meta", "wbr", "col", "area", "base", "source"}
+
+
+class _Page(HTMLParser):
+    """Checks that every element is closed in order; collects tables by id as cell texts."""
+
+    def __init__(self) -> None:
+        super().__init__(convert_charrefs=True)
+        self.stack: list[str] = []
+        self.tables: dict[str, list[tuple[str, list[str]]]] = {}
+        self.hrefs: list[str] = []
+        self.lead = ""
+        self._table: str | None = None
+        self._row: tuple[str, list[str]] | None = None
+        self._cell: list[str] | None = None
+        self._in_lead = False
+
+    def handle_starttag(self, tag: str, attrs: list[tuple[str, str | None]]) -> None:
+        a = dict(attrs)
+        if tag not in _VOID:
+            self.stack.append(tag)
+        if tag == "a" and a.get("href") is not None:
+            self.hrefs.append(a["href"] or "")
+        if tag == "table":
+            self._table = a.get("id") or f"anonymous-{len(self.tables)}"
+            self.tables[self._table] = []
+        elif tag == "tr" and self._table is not None:
+            self._row = (a.get("class") or "", [])
+        elif tag in ("td", "th") and self._row is not None:
+            self._cell = []
+        elif tag == "p" and a.get("class") == "lead":
+            self._in_lead = True
+
+    def handle_endtag(self, tag: str) -> None:
+        if tag in _VOID:
+            return
+        assert self.stack and self.stack[-1] == tag, f"</{tag}> closes {self.stack[-1:]}"
+        self.stack.pop()
+        if tag in ("td", "th") and self._cell is not None and self._row is not None:
+            self._row[1].append("".join(self._cell).strip())
+            self._cell = None
+        elif tag == "tr" and self._row is not None and self._table is not None:
+            if self._row[1] and self._row[0] != "":  # body rows carry a class
+                self.tables[self._table].append(self._row)
+            self._row = None
+        elif tag == "table":
+            self._table = None
+        elif tag == "p":
+            self._in_lead = False
+
+    def handle_data(self, data: str) -> None:
+        if self._cell is not None:
+            self._cell.append(data)
+        if self._in_lead:
+            self.lead += data
+
+
+@cache
+def _html(name: str) -> str:
+    wrapper = FMU_WRAPPERS[name]
+    return render_documentation(wrapper, component_class(name), REQUIREMENTS)
+
+
+@cache
+def _page(name: str) -> _Page:
+    page = _Page()
+    page.feed(_html(name))
+    page.close()
+    assert page.stack == [], f"unclosed elements {page.stack}"
+    return page
+
+
+def _rows(name: str, table: str, kind: str) -> list[list[str]]:
+    return [cells for cls, cells in _page(name).tables[table] if kind in cls.split()]
+
+
+def _connection_count(scene_path: str) -> int:
+    """Variable-level connections of a scene, counted from its TOML alone."""
+    scene = tomllib.loads((PROJECT_DIR / scene_path).read_text())
+    models = {inst: spec["component"] for inst, spec in scene["fmus"].items()}
+    n = 0
+    for entry in scene.get("connections", []):
+        if "ports" in entry:
+            (ia, pa), (ib, pb) = (p.split(".") for p in entry["ports"])
+            roles_a = component_class(models[ia]).PORTS[pa]
+            roles_b = component_class(models[ib]).PORTS[pb]
+            n += len(set(roles_a) & set(roles_b))
+        else:
+            n += 1
+    return n
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_page_is_standalone_well_formed_html5(name: str) -> None:
+    html = _html(name)
+    assert html.startswith('<!DOCTYPE html>\n<html lang="en">')
+    assert "<style>" in html and "<script" not in html and "<link" not in html
+    assert " src=" not in html
+    page = _page(name)  # parses, every element closed in order
+    assert all(h.startswith("#") for h in page.hrefs), page.hrefs  # in-page links only
+    ids = set(re.findall(r' id="([^"]+)"', html))
+    assert {h[1:] for h in page.hrefs} <= ids
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_names_identifier_and_the_wrapper_description(name: str) -> None:
+    script = FMU_WRAPPERS[name].script.read_text()
+    description = re.search(r'^\s+description = "(.*)"$', script, re.M).group(1)
+    assert _page(name).lead == description.rstrip(".")
+    assert f"<h1>{name}</h1>" in _html(name)
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_names_every_variable_with_its_table_entries(name: str) -> None:
+    cls = component_class(name)
+    rows = _rows(name, "variables-table", "variable")
+    assert [r[0] for r in rows] == [v.name for v in cls.VARIABLES]
+    for var, (vname, causality, _vtype, unit, _start, vmin, vmax, _desc, notes) in zip(
+        cls.VARIABLES, rows, strict=True
+    ):
+        assert (causality, unit) == (var.causality, var.unit), vname
+        assert (vmin == "") == (var.min is None) and (vmax == "") == (var.max is None), vname
+        if var.causality == "input":
+            assert ("sampled: the value is taken as a state" in notes) == var.sampled, vname
+        if var.causality == "output":
+            assert "direct feedthrough from: " in notes, vname
+            for dep in var.depends_on:
+                assert dep in notes, vname
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_lists_every_port_role(name: str) -> None:
+    cls = component_class(name)
+    for port, roles in cls.PORTS.items():
+        rows = _rows(name, f"port-{port}", "role")
+        assert [(r[0], r[1]) for r in rows] == list(roles.items())
+        for role, variable, direction, *_ in rows:
+            assert direction.startswith(cls.variable(variable).causality), role
+    if not cls.PORTS:
+        assert "no rotational ports" in _html(name)
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_lists_the_regimes_and_event_outputs(name: str) -> None:
+    cls = component_class(name)
+    names = getattr(cls, "REGIME_NAMES", {})
+    page = _page(name)
+    if names:
+        rows = _rows(name, "regimes", "regime")
+        assert [(int(c), n) for c, n in rows] == sorted(names.items())
+    else:
+        assert "regimes" not in page.tables
+    html = _html(name)
+    for var in cls.variables("output"):
+        if var.name.startswith("ind_") or var.name == "t_event":
+            assert f"<code>{var.name}</code>" in html
+
+
+@pytest.mark.parametrize("name", [n for n in NAMES if FMU_WRAPPERS[n].examples])
+def test_lists_every_connection_of_each_example(name: str) -> None:
+    for example in FMU_WRAPPERS[name].examples:
+        stem = example.rsplit("/", 1)[-1].removesuffix(".toml")
+        rows = _rows(name, f"connections-{stem}", "connection")
+        assert len(rows) == _connection_count(example), example
+
+
+def test_gear_train_lists_the_m739_connections_with_the_integer_one() -> None:
+    assert FMU_WRAPPERS["GearTrain"].examples == ("scenarios/m739.toml",)
+    expected = _connection_count("scenarios/m739.toml")
+    assert expected == 11
+    rows = _rows("GearTrain", "connections-m739", "connection")
+    assert len(rows) == expected
+    links = {r[1] for r in rows}
+    assert "train.phi -> verge.phi" in links and "verge.T_esc -> train.T_esc" in links
+    integers = _rows("GearTrain", "connections-m739", "integer")
+    assert [r[1] for r in integers] == ["verge.impact_count -> train.impact_count"]
+    assert integers[0][2].startswith("Integer")
+    assert "<code>&quot;30000 rpm&quot;</code>" in _html("GearTrain")  # as the scene writes it
+
+
+def test_host_requirements_and_tool_commands() -> None:
+    html = _html("GearTrain")
+    for line in REQUIREMENTS:
+        assert line.replace(">", "&gt;") in html
+    for text in (
+        "LD_PRELOAD=/path/to/libpython3.11.so",
+        "pythonfmu deploy -f GearTrain.fmu",
+        "fmpy info GearTrain.fmu",
+        "fmpy simulate GearTrain.fmu --start-values mu 0.1",
+        "simulate_fmu(",
+        "connect_integer_variables",
+        "canGetAndSetFMUstate",
+        "fmi2Error",
+    ):
+        assert text in html, text
+
+
+def test_a_missing_example_scene_is_an_error() -> None:
+    wrapper = dataclasses.replace(FMU_WRAPPERS["Inertia"], examples=("scenarios/nowhere.toml",))
+    with pytest.raises(DocumentationError, match="scenarios/nowhere.toml"):
+        render_documentation(wrapper, component_class("Inertia"), REQUIREMENTS)
+
+
+def test_registry_examples_exist_and_instantiate_their_fmu() -> None:
+    for name, wrapper in FMU_WRAPPERS.items():
+        for example in wrapper.examples:
+            scene = tomllib.loads((PROJECT_DIR / example).read_text())
+            assert name in {spec["component"] for spec in scene["fmus"].values()}, example
+
+
+def test_docstrings_keep_lists_equations_and_literals() -> None:
+    html = docstring_html(
+        """Title line.
+
+        Text with ``a < b`` and *emphasis*,
+        continued here.
+
+            J phi'' = T                      (1)
+
+        * first bullet
+          continued
+        * second
+
+        0. zero
+        1. one
+        """
+    )
+    assert "<p>Title line.</p>" in html
+    assert "<p>Text with <code>a &lt; b</code> and <em>emphasis</em>, continued here.</p>" in html
+    assert "<pre>J phi&#x27;&#x27; = T                      (1)</pre>" in html
+    assert "<ul><li>first bullet continued</li><li>second</li></ul>" in html
+    assert '<ol><li value="0">zero</li><li value="1">one</li></ol>' in html

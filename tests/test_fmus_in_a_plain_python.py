@@ -1,0 +1,92 @@
+"""Every FMU runs in a fresh virtual environment that has fmpy, pythonfmu and numpy (plus
+what the FMU's requirements.txt names) but not this project, as a user of another tool
+would have it; two of them in one process.  A missing requirement is named on standard
+error.  Slow: it installs packages into a new environment.
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+import venv
+import zipfile
+from pathlib import Path
+
+import pytest
+
+from fmus.build import build_fmu
+from fmus.registry import FMU_WRAPPERS
+
+pytestmark = pytest.mark.slow
+
+# Runs inside the plain environment: simulate each FMU named on the command line in this
+# one process and report what happened.
+PROBE = """
+import json, sys
+from fmpy import simulate_fmu
+report = {}
+try:
+    import components  # noqa: F401
+    report["project importable"] = True
+except ImportError:
+    report["project importable"] = False
+for path in sys.argv[1:]:
+    try:
+        result = simulate_fmu(path, stop_time=1e-3, output_interval=1e-4)
+        report[path] = ["ok", len(result)]
+    except Exception as exc:
+        report[path] = ["failed", str(exc)]
+print(json.dumps(report))
+"""
+
+
+def requirements(path: Path) -> list[str]:
+    with zipfile.ZipFile(path) as z:
+        return z.read("resources/requirements.txt").decode().split()
+
+
+def pip(python: Path, *packages: str) -> None:
+    subprocess.run(
+        [str(python), "-m", "pip", "install", "--quiet", "--disable-pip-version-check", *packages],
+        check=True,
+    )
+
+
+def probe(python: Path, paths: list[Path], cwd: Path) -> tuple[dict, str]:
+    run = subprocess.run(
+        [str(python), "-c", PROBE, *map(str, paths)],
+        capture_output=True,
+        text=True,
+        cwd=cwd,  # not the project: nothing of it on the path
+        timeout=600,
+    )
+    assert run.returncode == 0, run.stderr
+    return json.loads(run.stdout.strip().splitlines()[-1]), run.stderr
+
+
+def test_every_fmu_runs_in_a_plain_python(tmp_path: Path) -> None:
+    fmus = {name: build_fmu(name) for name in sorted(FMU_WRAPPERS)}
+    env = tmp_path / "venv"
+    venv.create(env, with_pip=True)
+    python = env / "bin" / "python"
+    pip(python, "fmpy", "pythonfmu", "numpy")
+    numpy_only = [p for p in fmus.values() if all("scipy" not in r for r in requirements(p))]
+    needs_scipy = [p for p in fmus.values() if p not in numpy_only]
+    assert numpy_only and needs_scipy
+
+    report, stderr = probe(python, [*numpy_only, *needs_scipy], tmp_path)
+    assert report.pop("project importable") is False
+    for path in numpy_only:
+        assert report[str(path)] == ["ok", 11], path
+    # Those that import scipy when loaded are refused, and the reason is named (some import
+    # it only for a computation the short run does not reach).
+    assert report[str(fmus["GearMesh"])][0] == "failed"
+    assert report[str(fmus["ClockGearTrain"])][0] == "failed"
+    assert "cannot load its Python code: No module named 'scipy'" in stderr
+
+    pip(python, *sorted({r for p in needs_scipy for r in requirements(p)}))
+    report, _ = probe(python, needs_scipy, tmp_path)
+    for path in needs_scipy:
+        assert report[str(path)] == ["ok", 11], path
+    assert sys.executable not in str(python)
