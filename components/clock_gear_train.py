@@ -75,6 +75,7 @@ from .gear_train import (
     ESCAPE_WHEEL_PORT,
     ESCAPE_WHEEL_VARIABLES,
     IMPACT_INPUTS,
+    MESH_FORCE_VARIABLES,
     WHEEL_INPUTS,
     TrainComponent,
     TrainLoadModel,
@@ -525,28 +526,7 @@ class ClockGearTrain(TrainComponent):
         Variable(
             "J_load", "input", "kg.m2", 0.0, "inertia riding on the wheel (handover)", sampled=True
         ),
-        Variable(
-            "F12", "output", "N", 0.0, "mesh-1 normal force (any regime)", depends_on=WHEEL_INPUTS
-        ),
-        Variable(
-            "F23", "output", "N", 0.0, "mesh-2 normal force (any regime)", depends_on=WHEEL_INPUTS
-        ),
-        Variable(
-            "FF12",
-            "output",
-            "N",
-            0.0,
-            "mesh-1 force when unloaded (T_esc = 0), else 0",
-            depends_on=WHEEL_INPUTS,
-        ),
-        Variable(
-            "FF23",
-            "output",
-            "N",
-            0.0,
-            "mesh-2 force when unloaded (T_esc = 0), else 0",
-            depends_on=WHEEL_INPUTS,
-        ),
+        *MESH_FORCE_VARIABLES,
         Variable("rotor_angle", "output", "rad", M739.phi1c, "rotor angle Phi"),
         Variable("speed_ratio", "output", "1", 32.0, "escape-wheel speed per rotor speed"),
         Variable(

@@ -567,6 +567,32 @@ ESCAPE_WHEEL_PORT = {
 IMPACT_INPUTS = ("impact_count", "phi_dot_impact")
 WHEEL_INPUTS = ("T_esc", "T_esc_static", "J_esc", *IMPACT_INPUTS)
 
+#: Mesh forces of both trains (involute and clock): they follow the load at once.
+MESH_FORCE_VARIABLES = (
+    Variable(
+        "F12", "output", "N", 0.0, "mesh-1 contact force (any regime)", depends_on=WHEEL_INPUTS
+    ),
+    Variable(
+        "F23", "output", "N", 0.0, "mesh-2 contact force (any regime)", depends_on=WHEEL_INPUTS
+    ),
+    Variable(
+        "FF12",
+        "output",
+        "N",
+        0.0,
+        "mesh-1 force when unloaded (T_esc = 0), else 0",
+        depends_on=WHEEL_INPUTS,
+    ),
+    Variable(
+        "FF23",
+        "output",
+        "N",
+        0.0,
+        "mesh-2 force when unloaded (T_esc = 0), else 0",
+        depends_on=WHEEL_INPUTS,
+    ),
+)
+
 #: The train side of that port.  Impact inputs are events taken once, not signals held
 #: over the step.
 ESCAPE_WHEEL_VARIABLES = (
@@ -737,28 +763,7 @@ class GearTrain(TrainComponent):
         Variable("phi_dot_start", "parameter", "rad/s", 0.0, "initial escape-wheel speed"),
         Variable("h_max", "parameter", "s", 1.0e-6, "largest internal RK4 step", min=0.0),
         *ESCAPE_WHEEL_VARIABLES,
-        Variable(
-            "F12", "output", "N", 0.0, "mesh-1 contact force (any regime)", depends_on=WHEEL_INPUTS
-        ),
-        Variable(
-            "F23", "output", "N", 0.0, "mesh-2 contact force (any regime)", depends_on=WHEEL_INPUTS
-        ),
-        Variable(
-            "FF12",
-            "output",
-            "N",
-            0.0,
-            "mesh-1 force when unloaded (T_esc = 0), else 0",
-            depends_on=WHEEL_INPUTS,
-        ),
-        Variable(
-            "FF23",
-            "output",
-            "N",
-            0.0,
-            "mesh-2 force when unloaded (T_esc = 0), else 0",
-            depends_on=WHEEL_INPUTS,
-        ),
+        *MESH_FORCE_VARIABLES,
         Variable("rotor_angle", "output", "rad", M739.phi1c, "rotor angle Phi"),
         # The mesh signs follow the direction of motion where the wheel rests on a tooth
         # change or pitch point, as at the M739 start (J1 = J2 = 0 at phi = 0).
