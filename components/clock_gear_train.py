@@ -71,16 +71,15 @@ from typing import Any
 
 from .base import ComponentError, Variable, common_outputs
 from .clock_train import M739_TRAIN, ClockMesh, ClockTrain
-from .gear_train import (
+from .escape_wheel import (
     ESCAPE_WHEEL_PORT,
     ESCAPE_WHEEL_VARIABLES,
     IMPACT_INPUTS,
     MESH_FORCE_VARIABLES,
     WHEEL_INPUTS,
-    TrainComponent,
-    TrainLoadModel,
 )
 from .m739_data import M739, M739Data
+from .train_component import TrainComponent, TrainLoadModel
 
 LOSS_NONE = 0
 LOSS_POINT = 1

@@ -28,18 +28,22 @@ Mesh position (§2.4, §10.2 item 6): alpha_i = alpha_in + mod(k_i phi + J_i ran
 with k2 = r_b3/R_b2 (physical, default) or 32 r_b3/R_b2 (the report's as-run rate),
 k1 = k2 r_b2/R_b1.  Tooth changes and pitch-point crossings are located as events.
 
-The module also holds the fixed-step RK4 integrator with event location used by both
-M739 components and the monolithic reference.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
-from typing import Any, Protocol
 
-from .base import Component, ComponentError, Variable, common_outputs
+from .base import ComponentError, Variable, common_outputs
+from .escape_wheel import (
+    ESCAPE_WHEEL_PORT,
+    ESCAPE_WHEEL_VARIABLES,
+    IMPACT_INPUTS,
+    MESH_FORCE_VARIABLES,
+    WHEEL_INPUTS,
+)
 from .m739_data import M739, M739Data
+from .train_component import TrainComponent, TrainLoadModel
 from .verge_geometry import fuze_angles
 
 INDEXING_PHYSICAL = 0
@@ -50,124 +54,6 @@ TRAIN_STUCK = 0
 TRAIN_FORWARD = 1
 TRAIN_BACKWARD = 2
 TRAIN_REGIME_NAMES = {TRAIN_STUCK: "stuck", TRAIN_FORWARD: "forward", TRAIN_BACKWARD: "backward"}
-
-
-# ---------------------------------------------------------------------------------------
-# Integrator: RK4 with event location on signed indicators
-# ---------------------------------------------------------------------------------------
-class EventModel(Protocol):
-    """What :func:`advance` needs from a model (the mode lives inside the model)."""
-
-    def deriv(self, y: list[float]) -> list[float]: ...
-
-    def indicators(self, y: list[float]) -> Sequence[float]: ...
-
-    def event(self, y: list[float], index: int, t: float) -> list[float]: ...
-
-    def accept(self, y: list[float], t: float) -> None: ...
-
-
-def rk4(deriv: Callable[[list[float]], list[float]], y: list[float], h: float) -> list[float]:
-    """One classical Runge-Kutta step (the mode is frozen during the step)."""
-    n = len(y)
-    k1 = deriv(y)
-    k2 = deriv([y[i] + 0.5 * h * k1[i] for i in range(n)])
-    k3 = deriv([y[i] + 0.5 * h * k2[i] for i in range(n)])
-    k4 = deriv([y[i] + h * k3[i] for i in range(n)])
-    h6 = h / 6.0
-    return [y[i] + h6 * (k1[i] + 2.0 * (k2[i] + k3[i]) + k4[i]) for i in range(n)]
-
-
-def _locate(
-    model: EventModel, y: list[float], h: float, idx: int, g_lo: float, g_hi: float, tol: float
-) -> tuple[float, list[float]]:
-    """Illinois root search on the step length for indicator idx (g_lo >= 0 > g_hi).
-
-    Returns the first point found with the indicator < 0, i.e. just past the crossing,
-    so that the event handler always sees the new side.
-    """
-    lo, hi = 0.0, h
-    y_hi = None
-    side = 0
-    for _ in range(60):
-        if hi - lo <= tol:
-            break
-        th = hi - g_hi * (hi - lo) / (g_hi - g_lo)
-        if not (lo < th < hi):
-            th = 0.5 * (lo + hi)
-        yt = rk4(model.deriv, y, th)
-        gt = model.indicators(yt)[idx]
-        if gt < 0.0:
-            hi, g_hi, y_hi = th, gt, yt
-            if side == -1:
-                g_lo *= 0.5
-            side = -1
-        else:
-            lo, g_lo = th, gt
-            if side == 1:
-                g_hi *= 0.5
-            side = 1
-    if y_hi is None:
-        y_hi = rk4(model.deriv, y, hi)
-    return hi, y_hi
-
-
-def advance(
-    model: EventModel,
-    y: list[float],
-    h_total: float,
-    h_max: float,
-    tol_t: float = 1e-14,
-    max_events: int = 2000,
-) -> tuple[list[float], float, float, int]:
-    """Integrate over h_total in RK4 steps <= h_max, stopping exactly at indicator crossings.
-
-    An indicator fires when it goes from >= 0 to < 0.  The model's ``event`` changes its
-    mode (and may change y); the integration then continues from the event point.
-    Returns (y, offsets of the first and of the last event from the start (-1.0 if
-    none), number of events).
-    """
-    t = 0.0
-    g0 = model.indicators(y)
-    n_events = 0
-    t_first = t_event = -1.0
-    end = h_total * (1.0 - 1e-14)
-    while t < end:
-        h = min(h_max, h_total - t)
-        y1 = rk4(model.deriv, y, h)
-        g1 = model.indicators(y1)
-        first = -1
-        th_best = h
-        y_best = y1
-        for i, (a, b) in enumerate(zip(g0, g1, strict=True)):
-            if a >= 0.0 and b < 0.0:
-                if a == 0.0:
-                    th, yy = 0.0, y
-                else:
-                    th, yy = _locate(model, y, h, i, a, b, tol_t)
-                if first < 0 or th < th_best:
-                    first, th_best, y_best = i, th, yy
-        if first < 0:
-            y = y1
-            t += h
-            model.accept(y, t)
-            g0 = g1
-            continue
-        y = y_best
-        t += th_best
-        if th_best > 0.0:
-            model.accept(y, t)
-        y = model.event(y, first, t)
-        g0 = model.indicators(y)
-        t_event = t
-        if t_first < 0.0:
-            t_first = t
-        n_events += 1
-        if n_events > max_events:
-            raise ComponentError("too many events inside one step (chattering)")
-        if getattr(model, "halted", False):
-            break
-    return y, t_first, t_event, n_events
 
 
 # ---------------------------------------------------------------------------------------
@@ -452,68 +338,6 @@ class TrainPhysics:
         self.i1r_sign = 1 if v * phi_ddot >= 0.0 else -1
 
 
-# ---------------------------------------------------------------------------------------
-# Component
-# ---------------------------------------------------------------------------------------
-class TrainLoadModel:
-    """A train model's held escapement load and its motion at zero wheel speed.
-
-    The load is affine in the wheel acceleration, t_esc - j_esc phi_dd (j_esc = 0: a plain
-    held torque), so J_ref phi_dd = T_ref + c (t_esc - j_esc phi_dd).  Reversal, start and
-    stick at zero speed need ``p`` (the physics: response, direction, set_direction,
-    update_i1r) and ``stuck``.
-    """
-
-    def __init__(self, phys: Any) -> None:
-        self.p = phys
-        self.t_esc = 0.0  # the held load; set from the inputs by TrainComponent._take_loads
-        self.j_esc = 0.0
-        self.stuck = False
-        self.t_first_event = -1.0  # first internal event (reversal, stick) in the step
-
-    def accel(self, phi: float, phi_dot: float) -> float:
-        j, t, c = self.p.response(phi, phi_dot)
-        return (t + c * self.t_esc) / (j + c * self.j_esc)
-
-    def load(self, phi_ddot: float) -> float:
-        """The escapement moment on the wheel at this acceleration."""
-        return self.t_esc - self.j_esc * phi_ddot
-
-    def reverse_or_stick(self, y: list[float]) -> list[float]:
-        """Speed crossed zero: reverse if the drive beats friction backwards, else stick."""
-        p = self.p
-        phi = y[0]
-        old = p.direction
-        for direction in (-old, old):
-            p.set_direction(direction, phi)
-            if direction * self.accel(phi, 0.0) > 0.0:
-                self._restart_branch(phi)
-                return [phi, 0.0, y[2]]
-        self.stuck = True
-        return [phi, 0.0, y[2]]
-
-    def try_unstick(self, phi: float) -> None:
-        """At rest: start in whichever direction the net torque beats static friction."""
-        p = self.p
-        held = p.direction
-        for direction in (held, -held):
-            p.set_direction(direction, phi)
-            if direction * self.accel(phi, 0.0) > 0.0:
-                self.stuck = False
-                self._restart_branch(phi)
-                return
-        # Stuck: keep the direction it had, so the outputs (and a master's exchange at
-        # this instant) do not flip between the two friction pieces from call to call.
-        p.set_direction(held, phi)
-        self.stuck = True
-
-    def _restart_branch(self, phi: float) -> None:
-        # The acceleration-dependent branches (I1R, normal-force signs) lag one accepted
-        # step; at a start from rest they take the new motion's acceleration at once, so
-        # the first step after it does not depend on its length.
-        self.p.update_i1r(0.0, self.accel(phi, 0.0))
-
-
 class _TrainModel(TrainLoadModel):
     """The train with a held escapement torque, as an EventModel; y = [phi, phi_d, W]."""
 
@@ -544,186 +368,6 @@ class _TrainModel(TrainLoadModel):
         if self.t_first_event < 0.0:
             self.t_first_event = t
         return self.reverse_or_stick(y)
-
-
-#: The escape-wheel port of a spin-driven train, and of the verge on the other side: the
-#: train sends the wheel state and its affine response, the verge the escapement moment
-#: and its affine form (T_esc = T_esc_static - J_esc phi_ddot).
-ESCAPE_WHEEL_PORT = {
-    "angle": "phi",
-    "speed": "phi_dot",
-    "torque": "T_esc",
-    "inertia": "J_ref",
-    "drive": "T_ref",
-    "load_factor": "c_load",
-    "impact_inertia": "J_stot",
-    "static_torque": "T_esc_static",
-    "load_inertia": "J_esc",
-}
-
-#: Direct feedthrough of a train: an impact sets the wheel speed at once, and at rest the
-#: held escapement load decides start, direction or stick, so whatever follows the wheel's
-#: speed, direction or acceleration depends on these inputs within one instant.
-IMPACT_INPUTS = ("impact_count", "phi_dot_impact")
-WHEEL_INPUTS = ("T_esc", "T_esc_static", "J_esc", *IMPACT_INPUTS)
-
-#: Mesh forces of both trains (involute and clock): they follow the load at once.
-MESH_FORCE_VARIABLES = (
-    Variable(
-        "F12", "output", "N", 0.0, "mesh-1 contact force (any regime)", depends_on=WHEEL_INPUTS
-    ),
-    Variable(
-        "F23", "output", "N", 0.0, "mesh-2 contact force (any regime)", depends_on=WHEEL_INPUTS
-    ),
-    Variable(
-        "FF12",
-        "output",
-        "N",
-        0.0,
-        "mesh-1 force when unloaded (T_esc = 0), else 0",
-        depends_on=WHEEL_INPUTS,
-    ),
-    Variable(
-        "FF23",
-        "output",
-        "N",
-        0.0,
-        "mesh-2 force when unloaded (T_esc = 0), else 0",
-        depends_on=WHEEL_INPUTS,
-    ),
-)
-
-#: The train side of that port.  Impact inputs are events taken once, not signals held
-#: over the step.
-ESCAPE_WHEEL_VARIABLES = (
-    Variable("T_esc", "input", "N.m", 0.0, "escapement moment on the escape wheel"),
-    Variable(
-        "T_esc_static",
-        "input",
-        "N.m",
-        0.0,
-        "escapement moment at zero wheel acceleration (used when J_esc != 0)",
-    ),
-    Variable(
-        "J_esc",
-        "input",
-        "kg.m2",
-        0.0,
-        "escapement inertia at the wheel: the load is T_esc_static - J_esc phi_ddot",
-    ),
-    Variable(
-        "impact_count",
-        "input",
-        "1",
-        0,
-        "incremented by the master at an impact",
-        "Integer",
-        sampled=True,
-    ),
-    Variable(
-        "phi_dot_impact", "input", "rad/s", 0.0, "escape-wheel speed after impact", sampled=True
-    ),
-    Variable("phi", "output", "rad", 0.0, "cumulative escape-wheel angle"),
-    Variable("phi_dot", "output", "rad/s", 0.0, "escape-wheel speed", depends_on=IMPACT_INPUTS),
-    Variable(
-        "phi_ddot", "output", "rad/s2", 0.0, "escape-wheel acceleration", depends_on=WHEEL_INPUTS
-    ),
-    Variable(
-        "J_ref",
-        "output",
-        "kg.m2",
-        0.0,
-        "effective inertia at the escape wheel",
-        depends_on=WHEEL_INPUTS,
-    ),
-    Variable(
-        "T_ref",
-        "output",
-        "N.m",
-        0.0,
-        "net train torque at the escape wheel",
-        depends_on=WHEEL_INPUTS,
-    ),
-    Variable("c_load", "output", "1", 1.0, "factor of T_esc in J_ref phi_dd = T_ref + c T_esc"),
-    Variable("J_stot", "output", "kg.m2", 0.0, "frictionless reflected inertia (impacts, B213)"),
-)
-
-
-class TrainComponent(Component):
-    """What every spin-driven train FMU shares: taking impacts and the held escapement load,
-    stepping the 1-DOF model with event location, and cheap state snapshots.
-
-    A subclass names its physics and model classes and provides ``initialize`` and
-    ``_outputs``; ``self._phys``, ``self._model`` and ``self._y`` hold the state.
-    """
-
-    _PHYSICS: type
-    _MODEL: type
-
-    def _take_loads(self) -> None:
-        """Copy the held inputs the model integrates with: the escapement as an affine
-        load when its inertia at the wheel is given, else the plain torque."""
-        m = self._model
-        m.j_esc = self.J_esc
-        m.t_esc = self.T_esc_static if self.J_esc != 0.0 else self.T_esc
-
-    def _apply_inputs(self) -> None:
-        """Take a new impact speed (once per impact_count change) and the held load.
-
-        Idempotent, so it may run in update_outputs and again at the step start.
-        """
-        self._take_loads()
-        m, y = self._model, self._y
-        if int(self.impact_count) != self._seen_impacts:
-            self._seen_impacts = int(self.impact_count)
-            y = self._y = [y[0], self.phi_dot_impact, y[2]]
-            if y[1] != 0.0:
-                m.p.set_direction(1 if y[1] > 0.0 else -1, y[0])
-                m.stuck = False
-        if y[1] == 0.0:
-            m.try_unstick(y[0])
-        elif m.p.direction * y[1] < 0.0:
-            m.p.set_direction(1 if y[1] > 0.0 else -1, y[0])
-
-    def update_outputs(self) -> None:
-        # Direct feedthrough: F12, F23, phi_ddot depend on T_esc; an impact sets phi_dot.
-        self._apply_inputs()
-        self._outputs()
-
-    def step(self, t: float, h: float) -> None:
-        self._apply_inputs()
-        m = self._model
-        m.t_first_event = -1.0
-        if m.stuck and self._y[1] == 0.0:
-            # Held at rest by static friction under held inputs: nothing moves in this step.
-            self._outputs()
-            return
-        self._y, _, _, _ = advance(m, self._y, h, self.h_max)
-        if m.t_first_event >= 0.0:
-            self.t_event = t + m.t_first_event
-        self._outputs()
-
-    # The snapshot copies the mutable mode and state; the constants (and the memo of
-    # mode-only coefficients) are immutable in use and shared, which keeps it cheap.
-    def get_state(self) -> dict[str, Any]:
-        snap = dict(self.__dict__)
-        if "_phys" in snap:
-            snap["_y"] = list(self._y)
-            snap["_phys"] = dict(self._phys.__dict__)
-            snap["_model"] = {n: v for n, v in self._model.__dict__.items() if n != "p"}
-        return snap
-
-    def set_state(self, state: dict[str, Any]) -> None:
-        self.__dict__.clear()
-        self.__dict__.update(state)
-        if "_phys" in state:
-            self._y = list(state["_y"])
-            phys = self._PHYSICS.__new__(self._PHYSICS)
-            phys.__dict__.update(state["_phys"])
-            model = self._MODEL.__new__(self._MODEL)
-            model.__dict__.update(state["_model"])
-            model.p = phys
-            self._phys, self._model = phys, model
 
 
 class GearTrain(TrainComponent):

@@ -51,7 +51,8 @@ from collections.abc import Callable
 from typing import Any
 
 from .base import Component, ComponentError, Variable, common_outputs
-from .gear_train import ESCAPE_WHEEL_PORT, advance
+from .escape_wheel import ESCAPE_WHEEL_PORT
+from .event_integration import advance
 from .m739_data import M739, M739Data
 from .verge_geometry import (
     TWO_PI,

@@ -22,7 +22,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from components.gear_train import INDEXING_AS_RUN, INDEXING_PHYSICAL, TrainPhysics, advance
+from components.event_integration import advance
+from components.gear_train import INDEXING_AS_RUN, INDEXING_PHYSICAL, TrainPhysics
 from components.m739_data import M739, M739Data, rpm_to_rad_s
 from components.verge_escapement import REGIME_NAMES, VergeConstants, VergeCore
 

@@ -1,0 +1,112 @@
+"""The escape-wheel port between a spin-driven train and its escapement.
+
+The train sends the wheel state and its affine response J_ref phi_dd = T_ref + c_load T_esc;
+the escapement sends its moment T_esc, in affine form T_esc = T_esc_static - J_esc phi_dd
+when its inertia rides on the wheel, and applies impacts as a new wheel speed.
+"""
+
+from __future__ import annotations
+
+from .base import Variable
+
+#: The escape-wheel port of a spin-driven train, and of the verge on the other side: the
+#: train sends the wheel state and its affine response, the verge the escapement moment
+#: and its affine form (T_esc = T_esc_static - J_esc phi_ddot).
+ESCAPE_WHEEL_PORT = {
+    "angle": "phi",
+    "speed": "phi_dot",
+    "torque": "T_esc",
+    "inertia": "J_ref",
+    "drive": "T_ref",
+    "load_factor": "c_load",
+    "impact_inertia": "J_stot",
+    "static_torque": "T_esc_static",
+    "load_inertia": "J_esc",
+}
+
+#: Direct feedthrough of a train: an impact sets the wheel speed at once, and at rest the
+#: held escapement load decides start, direction or stick, so whatever follows the wheel's
+#: speed, direction or acceleration depends on these inputs within one instant.
+IMPACT_INPUTS = ("impact_count", "phi_dot_impact")
+WHEEL_INPUTS = ("T_esc", "T_esc_static", "J_esc", *IMPACT_INPUTS)
+
+#: Mesh forces of both trains (involute and clock): they follow the load at once.
+MESH_FORCE_VARIABLES = (
+    Variable(
+        "F12", "output", "N", 0.0, "mesh-1 contact force (any regime)", depends_on=WHEEL_INPUTS
+    ),
+    Variable(
+        "F23", "output", "N", 0.0, "mesh-2 contact force (any regime)", depends_on=WHEEL_INPUTS
+    ),
+    Variable(
+        "FF12",
+        "output",
+        "N",
+        0.0,
+        "mesh-1 force when unloaded (T_esc = 0), else 0",
+        depends_on=WHEEL_INPUTS,
+    ),
+    Variable(
+        "FF23",
+        "output",
+        "N",
+        0.0,
+        "mesh-2 force when unloaded (T_esc = 0), else 0",
+        depends_on=WHEEL_INPUTS,
+    ),
+)
+
+#: The train side of that port.  Impact inputs are events taken once, not signals held
+#: over the step.
+ESCAPE_WHEEL_VARIABLES = (
+    Variable("T_esc", "input", "N.m", 0.0, "escapement moment on the escape wheel"),
+    Variable(
+        "T_esc_static",
+        "input",
+        "N.m",
+        0.0,
+        "escapement moment at zero wheel acceleration (used when J_esc != 0)",
+    ),
+    Variable(
+        "J_esc",
+        "input",
+        "kg.m2",
+        0.0,
+        "escapement inertia at the wheel: the load is T_esc_static - J_esc phi_ddot",
+    ),
+    Variable(
+        "impact_count",
+        "input",
+        "1",
+        0,
+        "incremented by the master at an impact",
+        "Integer",
+        sampled=True,
+    ),
+    Variable(
+        "phi_dot_impact", "input", "rad/s", 0.0, "escape-wheel speed after impact", sampled=True
+    ),
+    Variable("phi", "output", "rad", 0.0, "cumulative escape-wheel angle"),
+    Variable("phi_dot", "output", "rad/s", 0.0, "escape-wheel speed", depends_on=IMPACT_INPUTS),
+    Variable(
+        "phi_ddot", "output", "rad/s2", 0.0, "escape-wheel acceleration", depends_on=WHEEL_INPUTS
+    ),
+    Variable(
+        "J_ref",
+        "output",
+        "kg.m2",
+        0.0,
+        "effective inertia at the escape wheel",
+        depends_on=WHEEL_INPUTS,
+    ),
+    Variable(
+        "T_ref",
+        "output",
+        "N.m",
+        0.0,
+        "net train torque at the escape wheel",
+        depends_on=WHEEL_INPUTS,
+    ),
+    Variable("c_load", "output", "1", 1.0, "factor of T_esc in J_ref phi_dd = T_ref + c T_esc"),
+    Variable("J_stot", "output", "kg.m2", 0.0, "frictionless reflected inertia (impacts, B213)"),
+)

@@ -1,0 +1,147 @@
+"""What every spin-driven train FMU shares: the held escapement load and the motion at zero
+wheel speed (start, reversal, stick), taking impacts, stepping with event location, and
+cheap state snapshots.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from .base import Component
+from .event_integration import advance
+
+
+class TrainLoadModel:
+    """A train model's held escapement load and its motion at zero wheel speed.
+
+    The load is affine in the wheel acceleration, t_esc - j_esc phi_dd (j_esc = 0: a plain
+    held torque), so J_ref phi_dd = T_ref + c (t_esc - j_esc phi_dd).  Reversal, start and
+    stick at zero speed need ``p`` (the physics: response, direction, set_direction,
+    update_i1r) and ``stuck``.
+    """
+
+    def __init__(self, phys: Any) -> None:
+        self.p = phys
+        self.t_esc = 0.0  # the held load; set from the inputs by TrainComponent._take_loads
+        self.j_esc = 0.0
+        self.stuck = False
+        self.t_first_event = -1.0  # first internal event (reversal, stick) in the step
+
+    def accel(self, phi: float, phi_dot: float) -> float:
+        j, t, c = self.p.response(phi, phi_dot)
+        return (t + c * self.t_esc) / (j + c * self.j_esc)
+
+    def load(self, phi_ddot: float) -> float:
+        """The escapement moment on the wheel at this acceleration."""
+        return self.t_esc - self.j_esc * phi_ddot
+
+    def reverse_or_stick(self, y: list[float]) -> list[float]:
+        """Speed crossed zero: reverse if the drive beats friction backwards, else stick."""
+        p = self.p
+        phi = y[0]
+        old = p.direction
+        for direction in (-old, old):
+            p.set_direction(direction, phi)
+            if direction * self.accel(phi, 0.0) > 0.0:
+                self._restart_branch(phi)
+                return [phi, 0.0, y[2]]
+        self.stuck = True
+        return [phi, 0.0, y[2]]
+
+    def try_unstick(self, phi: float) -> None:
+        """At rest: start in whichever direction the net torque beats static friction."""
+        p = self.p
+        held = p.direction
+        for direction in (held, -held):
+            p.set_direction(direction, phi)
+            if direction * self.accel(phi, 0.0) > 0.0:
+                self.stuck = False
+                self._restart_branch(phi)
+                return
+        # Stuck: keep the direction it had, so the outputs (and a master's exchange at
+        # this instant) do not flip between the two friction pieces from call to call.
+        p.set_direction(held, phi)
+        self.stuck = True
+
+    def _restart_branch(self, phi: float) -> None:
+        # The acceleration-dependent branches (I1R, normal-force signs) lag one accepted
+        # step; at a start from rest they take the new motion's acceleration at once, so
+        # the first step after it does not depend on its length.
+        self.p.update_i1r(0.0, self.accel(phi, 0.0))
+
+
+class TrainComponent(Component):
+    """What every spin-driven train FMU shares: taking impacts and the held escapement load,
+    stepping the 1-DOF model with event location, and cheap state snapshots.
+
+    A subclass names its physics and model classes and provides ``initialize`` and
+    ``_outputs``; ``self._phys``, ``self._model`` and ``self._y`` hold the state.
+    """
+
+    _PHYSICS: type
+    _MODEL: type
+
+    def _take_loads(self) -> None:
+        """Copy the held inputs the model integrates with: the escapement as an affine
+        load when its inertia at the wheel is given, else the plain torque."""
+        m = self._model
+        m.j_esc = self.J_esc
+        m.t_esc = self.T_esc_static if self.J_esc != 0.0 else self.T_esc
+
+    def _apply_inputs(self) -> None:
+        """Take a new impact speed (once per impact_count change) and the held load.
+
+        Idempotent, so it may run in update_outputs and again at the step start.
+        """
+        self._take_loads()
+        m, y = self._model, self._y
+        if int(self.impact_count) != self._seen_impacts:
+            self._seen_impacts = int(self.impact_count)
+            y = self._y = [y[0], self.phi_dot_impact, y[2]]
+            if y[1] != 0.0:
+                m.p.set_direction(1 if y[1] > 0.0 else -1, y[0])
+                m.stuck = False
+        if y[1] == 0.0:
+            m.try_unstick(y[0])
+        elif m.p.direction * y[1] < 0.0:
+            m.p.set_direction(1 if y[1] > 0.0 else -1, y[0])
+
+    def update_outputs(self) -> None:
+        # Direct feedthrough: F12, F23, phi_ddot depend on T_esc; an impact sets phi_dot.
+        self._apply_inputs()
+        self._outputs()
+
+    def step(self, t: float, h: float) -> None:
+        self._apply_inputs()
+        m = self._model
+        m.t_first_event = -1.0
+        if m.stuck and self._y[1] == 0.0:
+            # Held at rest by static friction under held inputs: nothing moves in this step.
+            self._outputs()
+            return
+        self._y, _, _, _ = advance(m, self._y, h, self.h_max)
+        if m.t_first_event >= 0.0:
+            self.t_event = t + m.t_first_event
+        self._outputs()
+
+    # The snapshot copies the mutable mode and state; the constants (and the memo of
+    # mode-only coefficients) are immutable in use and shared, which keeps it cheap.
+    def get_state(self) -> dict[str, Any]:
+        snap = dict(self.__dict__)
+        if "_phys" in snap:
+            snap["_y"] = list(self._y)
+            snap["_phys"] = dict(self._phys.__dict__)
+            snap["_model"] = {n: v for n, v in self._model.__dict__.items() if n != "p"}
+        return snap
+
+    def set_state(self, state: dict[str, Any]) -> None:
+        self.__dict__.clear()
+        self.__dict__.update(state)
+        if "_phys" in state:
+            self._y = list(state["_y"])
+            phys = self._PHYSICS.__new__(self._PHYSICS)
+            phys.__dict__.update(state["_phys"])
+            model = self._MODEL.__new__(self._MODEL)
+            model.__dict__.update(state["_model"])
+            model.p = phys
+            self._phys, self._model = phys, model
