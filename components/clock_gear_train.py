@@ -78,6 +78,7 @@ from .escape_wheel import (
     MESH_FORCE_VARIABLES,
     WHEEL_INPUTS,
 )
+from .event_integration import INTEGRATION_VARIABLES
 from .m739_data import M739, M739Data
 from .train_component import TrainComponent, TrainLoadModel
 
@@ -404,7 +405,8 @@ class ClockTrainPhysics:
         self.cross(phi, 0.0)
 
     def update_i1r(self, phi_dot: float, phi_ddot: float) -> None:
-        """Normal-force signs from the accepted acceleration (lagged, as gear_train's I1R).
+        """Normal-force signs from the acceleration, switched where a computed mesh force
+        changes sign (``branch_indicators``).
 
         The name is the one ``VergeCore`` calls on a live train.
         """
@@ -412,6 +414,13 @@ class ClockTrainPhysics:
             return
         n1, n2 = self.forces(self.evaluate_phi, phi_dot, phi_ddot)
         self.sigma = (1 if n1 >= 0.0 else -1, 1 if n2 >= 0.0 else -1)
+
+    def branch_indicators(self, phi: float, phi_dot: float, phi_ddot: float) -> tuple[float, float]:
+        """sigma_i N_i of both meshes: negative where a normal force changes sign."""
+        if self.loss_model == LOSS_NONE or self.mu == 0.0:
+            return (1.0, 1.0)
+        n1, n2 = self.forces(phi, phi_dot, phi_ddot)
+        return (self.sigma[0] * n1, self.sigma[1] * n2)
 
     @property
     def evaluate_phi(self) -> float:
@@ -429,7 +438,8 @@ class ClockTrainPhysics:
 class _ClockModel(TrainLoadModel):
     """The clock train with a held escapement torque, as an EventModel; y = [phi, phi_d, W].
 
-    Indicators: piece bounds ahead (mesh 1, mesh 2), pitch points (mesh 1, mesh 2), speed.
+    Indicators: piece bounds ahead (mesh 1, mesh 2), pitch points (mesh 1, mesh 2), speed,
+    signs of the two mesh normal forces.
     """
 
     def __init__(self, phys: ClockTrainPhysics) -> None:
@@ -457,20 +467,24 @@ class _ClockModel(TrainLoadModel):
         else:
             m1, m2 = b1, b2
         if self.stuck:
-            return (m1, m2, s1, s2, 0.0)
-        return (m1, m2, s1, s2, p.direction * y[1])
-
-    def accept(self, y: list[float], t: float) -> None:
-        if not self.stuck:
-            self.p.update_i1r(y[1], self.accel(y[0], y[1]))
+            return (m1, m2, s1, s2, 0.0, 0.0, 0.0)
+        w = y[1]
+        return (m1, m2, s1, s2, p.direction * w, *p.branch_indicators(y[0], w, self.accel(y[0], w)))
 
     def event(self, y: list[float], index: int, t: float) -> list[float]:
-        if self.t_first_event < 0.0:
-            self.t_first_event = t
-        if index < 4:
-            w, loss = self.p.cross(y[0], y[1], self.j_load)
-            return [y[0], w, y[2] + loss]
-        return self.reverse_or_stick(y)
+        if index <= 4:
+            if self.t_first_event < 0.0:
+                self.t_first_event = t
+            if index < 4:
+                w, loss = self.p.cross(y[0], y[1], self.j_load)
+                y = [y[0], w, y[2] + loss]
+            else:
+                y = self.reverse_or_stick(y)
+        # Past 4 a normal force changed sign (friction branch, not a regime change); after
+        # a regime change the branches follow the new acceleration at once.
+        if not self.stuck:
+            self.p.update_i1r(y[1], self.accel(y[0], y[1]))
+        return y
 
 
 class ClockGearTrain(TrainComponent):
@@ -520,7 +534,7 @@ class ClockGearTrain(TrainComponent):
         ),
         Variable("phi_start", "parameter", "rad", 0.0, "initial cumulative escape-wheel angle"),
         Variable("phi_dot_start", "parameter", "rad/s", 0.0, "initial escape-wheel speed"),
-        Variable("h_max", "parameter", "s", 1.0e-6, "largest internal RK4 step", min=0.0),
+        *INTEGRATION_VARIABLES,
         *ESCAPE_WHEEL_VARIABLES,
         Variable(
             "J_load", "input", "kg.m2", 0.0, "inertia riding on the wheel (handover)", sampled=True
@@ -575,8 +589,7 @@ class ClockGearTrain(TrainComponent):
     )
 
     def initialize(self, t0: float) -> None:
-        if not self.h_max > 0.0:
-            raise ComponentError("ClockGearTrain: h_max must be positive")
+        self._start_integration()
         if self.pivot_loads not in (0.0, 1.0):
             raise ComponentError("ClockGearTrain: pivot_loads must be 0 or 1")
         self._phys = ClockTrainPhysics(

@@ -21,7 +21,7 @@ the tooth force (verge state), so the escapement side computes it.  With that sp
 dependence on T_esc is exactly affine with unit factor.  It is only piecewise in the
 *state*: the pieces are selected by sgn(phi_d) (friction reversal, eq. 7), by the
 approach/recess signs s1, s2 of both meshes and the current tooth pair, and by the
-branch of I1R (sign of phi_d times the previous accepted acceleration).  The outputs
+branch of I1R (sign of phi_d times the acceleration, a located event).  The outputs
 J_ref, T_ref are those of the piece in force at the current state.
 
 Mesh position (§2.4, §10.2 item 6): alpha_i = alpha_in + mod(k_i phi + J_i range, range)
@@ -34,7 +34,7 @@ from __future__ import annotations
 
 import math
 
-from .base import ComponentError, Variable, common_outputs
+from .base import Variable, common_outputs
 from .escape_wheel import (
     ESCAPE_WHEEL_PORT,
     ESCAPE_WHEEL_VARIABLES,
@@ -42,6 +42,7 @@ from .escape_wheel import (
     MESH_FORCE_VARIABLES,
     WHEEL_INPUTS,
 )
+from .event_integration import INTEGRATION_VARIABLES
 from .m739_data import M739, M739Data
 from .train_component import TrainComponent, TrainLoadModel
 from .verge_geometry import fuze_angles
@@ -327,19 +328,42 @@ class TrainPhysics:
     def on_mesh_event(self, phi: float) -> None:
         """Move to the piece beyond a located tooth-change or pitch-point crossing."""
         self.set_mode(phi, self.direction)
+        # The crossing is located in phi but the pieces are cut in the mesh phases: at a
+        # rounding tie phi can sit past the boundary while its phase does not, and the
+        # piece would not move (its indicator then stays negative and the next crossing is
+        # never seen).  Probe just beyond the boundary instead.
+        for _ in range(3):
+            hi, lo = self.mesh_indicators(phi)
+            ahead = hi if self.direction > 0 else lo
+            if ahead > 0.0:
+                return
+            edge = self.phi_hi if self.direction > 0 else self.phi_lo
+            self.set_mode(edge + self.direction * 1e-12 * max(1.0, abs(edge)), self.direction)
 
     def set_direction(self, direction: int, phi: float) -> None:
         """Friction reversal (eq. 7); the pieces are re-derived for the new direction."""
         self.set_mode(phi, direction)
 
     def update_i1r(self, phi_dot: float, phi_ddot: float) -> None:
-        """I1R branch from the accepted acceleration (the report's lagged rule, §4.1)."""
+        """I1R branch from the acceleration: the sign of the rotor's pivot friction moment
+        that grows with its acceleration (Lowen & Tepper 1982, B144 and its I1R term).  The
+        report takes it from the last accepted step; here it switches at the located
+        instant where velocity times acceleration changes sign (``branch_indicators``), the
+        limit of the report's rule as its step goes to zero."""
         v = phi_dot if phi_dot != 0.0 else float(self.direction)
         self.i1r_sign = 1 if v * phi_ddot >= 0.0 else -1
 
+    def branch_indicators(self, phi: float, phi_dot: float, phi_ddot: float) -> tuple[float]:
+        """Negative where the I1R branch no longer matches the motion (see update_i1r)."""
+        v = phi_dot if phi_dot != 0.0 else float(self.direction)
+        return (self.i1r_sign * v * phi_ddot,)
+
 
 class _TrainModel(TrainLoadModel):
-    """The train with a held escapement torque, as an EventModel; y = [phi, phi_d, W]."""
+    """The train with a held escapement torque, as an EventModel; y = [phi, phi_d, W].
+
+    Indicators: mesh piece ends ahead and behind, speed (reversal/stick), I1R branch.
+    """
 
     def deriv(self, y: list[float]) -> list[float]:
         if self.stuck:
@@ -350,24 +374,24 @@ class _TrainModel(TrainLoadModel):
         p_loss = w * (self.load(a) + self.p.drive_torque(phi) - self.p.i_stot * a)
         return [w, a, p_loss]
 
-    def indicators(self, y: list[float]) -> tuple[float, float, float]:
+    def indicators(self, y: list[float]) -> tuple[float, ...]:
         hi, lo = self.p.mesh_indicators(y[0])
         if self.stuck:
-            return (hi, lo, 0.0)
-        return (hi, lo, self.p.direction * y[1])
-
-    def accept(self, y: list[float], t: float) -> None:
-        if not self.stuck:
-            self.p.update_i1r(y[1], self.accel(y[0], y[1]))
+            return (hi, lo, 0.0, 0.0)
+        phi, w = y[0], y[1]
+        return (hi, lo, self.p.direction * w, *self.p.branch_indicators(phi, w, self.accel(phi, w)))
 
     def event(self, y: list[float], index: int, t: float) -> list[float]:
         p = self.p
         if index < 2:
             p.on_mesh_event(y[0])
-            return y
-        if self.t_first_event < 0.0:
-            self.t_first_event = t
-        return self.reverse_or_stick(y)
+        elif index == 2:
+            if self.t_first_event < 0.0:
+                self.t_first_event = t
+            y = self.reverse_or_stick(y)
+        if not self.stuck:  # the branch follows the acceleration of the new piece at once
+            p.update_i1r(y[1], self.accel(y[0], y[1]))
+        return y
 
 
 class GearTrain(TrainComponent):
@@ -405,7 +429,7 @@ class GearTrain(TrainComponent):
         ),
         Variable("phi_start", "parameter", "rad", 0.0, "initial cumulative escape-wheel angle"),
         Variable("phi_dot_start", "parameter", "rad/s", 0.0, "initial escape-wheel speed"),
-        Variable("h_max", "parameter", "s", 1.0e-6, "largest internal RK4 step", min=0.0),
+        *INTEGRATION_VARIABLES,
         *ESCAPE_WHEEL_VARIABLES,
         *MESH_FORCE_VARIABLES,
         Variable("rotor_angle", "output", "rad", M739.phi1c, "rotor angle Phi"),
@@ -443,8 +467,7 @@ class GearTrain(TrainComponent):
     )
 
     def initialize(self, t0: float) -> None:
-        if self.h_max <= 0.0:
-            raise ComponentError("GearTrain: h_max must be positive")
+        self._start_integration()
         self._phys = TrainPhysics(M739, mu=self.mu, omega=self.spin, indexing=int(self.indexing))
         self._y = [self.phi_start, self.phi_dot_start, 0.0]
         direction = -1 if self.phi_dot_start < 0.0 else 1

@@ -8,7 +8,11 @@ from __future__ import annotations
 from typing import Any
 
 from .base import Component
-from .event_integration import advance
+from .event_integration import advance, step_control
+
+#: Magnitudes below which the integration controls the state [phi, phi_d, W] absolutely:
+#: rad, rad/s, J.
+STATE_SCALES = (1.0, 10.0, 1.0e-3)
 
 
 class TrainLoadModel:
@@ -88,6 +92,11 @@ class TrainComponent(Component):
         m.j_esc = self.J_esc
         m.t_esc = self.T_esc_static if self.J_esc != 0.0 else self.T_esc
 
+    def _start_integration(self) -> None:
+        """The integration accuracy from the parameters (initialize calls it first)."""
+        self._control = step_control(self, STATE_SCALES)
+        self._h_next = 0.0
+
     def _apply_inputs(self) -> None:
         """Take a new impact speed (once per impact_count change) and the held load.
 
@@ -119,7 +128,8 @@ class TrainComponent(Component):
             # Held at rest by static friction under held inputs: nothing moves in this step.
             self._outputs()
             return
-        self._y, _, _, _ = advance(m, self._y, h, self.h_max)
+        done = advance(m, self._y, h, self._control, self._h_next)
+        self._y, self._h_next = done.y, done.h_next
         if m.t_first_event >= 0.0:
             self.t_event = t + m.t_first_event
         self._outputs()

@@ -52,7 +52,7 @@ from typing import Any
 
 from .base import Component, ComponentError, Variable, common_outputs
 from .escape_wheel import ESCAPE_WHEEL_PORT
-from .event_integration import advance
+from .event_integration import INTEGRATION_VARIABLES, advance, step_control
 from .m739_data import M739, M739Data
 from .verge_geometry import (
     TWO_PI,
@@ -69,6 +69,10 @@ COUPLED_EXIT = 2
 ENTRANCE = 1
 EXIT = -1
 
+#: Magnitudes below which the integration controls the state [phi, phi_d, psi, psi_d, W]
+#: absolutely: rad, rad/s, rad, rad/s, J.
+STATE_SCALES = (1.0, 10.0, 0.1, 10.0, 1.0e-3)
+
 REGIME_NAMES = {FREE: "free", COUPLED_ENTRANCE: "coupled-entrance", COUPLED_EXIT: "coupled-exit"}
 
 # Indicator slots.
@@ -80,6 +84,8 @@ IND_WHEEL_SPEED = 4
 IND_MESH_HI = 5
 IND_MESH_LO = 6
 IND_STOP = 7
+IND_IPR = 8  # branch of the verge's acceleration-dependent pivot friction
+IND_TRAIN_BRANCH = 9  # and on: the train's branch indicators (none for a held train)
 # Direct feedthrough of the verge: the wheel state, and with it the train's response.
 _WHEEL_STATE = ("phi", "phi_dot")
 _WHEEL_AND_TRAIN = (*_WHEEL_STATE, "J_ref", "T_ref", "c_load")
@@ -306,6 +312,9 @@ class HeldTrain:
     def update_i1r(self, phi_dot: float, phi_ddot: float) -> None:
         pass
 
+    def branch_indicators(self, phi: float, phi_dot: float, phi_ddot: float) -> tuple[()]:
+        return ()
+
 
 class VergeCore:
     """Regime machine and right-hand sides; y = [phi_T, phi_d, psi, psi_d, W_verge].
@@ -462,7 +471,17 @@ class VergeCore:
         stop = self.phi_stop - y[0]
         if self.coupled:
             _, _, psi_d, _, pn, _, g, _, vst, *_ = self.coupled_terms(y)
-            return (sigma * g, pn, self.s4 * vst, self.s5 * psi_d, wheel, hi, lo, stop)
+            return (
+                sigma * g,
+                pn,
+                self.s4 * vst,
+                self.s5 * psi_d,
+                wheel,
+                hi,
+                lo,
+                stop,
+                *self._branch_indicators(y),
+            )
         phi_l = y[0] + self.phi_off
         psi = y[2]
         alpha = k.alpha[sigma]
@@ -470,15 +489,37 @@ class VergeCore:
         f = k.a * math.sin(psi + alpha) - k.b * math.sin(arg) - k.c * math.sin(alpha)
         gp = k.a * math.cos(psi + alpha) + k.b * math.cos(arg) - k.c * math.cos(alpha)
         verge = 1.0 if self.verge_stuck else self.s5 * y[3]
-        return (sigma * gp, sigma * f, 1.0, verge, wheel, hi, lo, stop)
+        return (sigma * gp, sigma * f, 1.0, verge, wheel, hi, lo, stop, *self._branch_indicators(y))
 
-    def accept(self, y: list[float], t: float) -> None:
+    def _branch_indicators(self, y: list[float]) -> tuple[float, ...]:
+        """Negative where an acceleration-dependent friction branch no longer matches the
+        motion: the verge's I_PR (velocity times acceleration of the verge) and the
+        train's own.  The report takes these signs from the last accepted step; switching
+        them at the located instant is that rule's limit as the step goes to zero."""
         d = self.deriv(y)
-        self.train.update_i1r(y[1], d[1])
         v = y[3] if y[3] != 0.0 else float(self.s5)
-        self.ipr_sign = 1 if v * d[3] >= 0.0 else -1
+        return (self.ipr_sign * v * d[3], *self.train.branch_indicators(y[0], y[1], d[1]))
+
+    def _switch_branch(self, y: list[float], index: int) -> list[float]:
+        d = self.deriv(y)
+        if index == IND_IPR:
+            v = y[3] if y[3] != 0.0 else float(self.s5)
+            self.ipr_sign = 1 if v * d[3] >= 0.0 else -1
+        else:
+            self.train.update_i1r(y[1], d[1])
+        return y
 
     def event(self, y: list[float], index: int, t: float) -> list[float]:
+        if index >= IND_IPR:
+            return self._switch_branch(y, index)
+        y = self._regime_event(y, index, t)
+        if not (self.halted or self.train_stuck):
+            # A regime change can jump the accelerations: the branches follow at once.
+            self._switch_branch(y, IND_IPR)
+            self._switch_branch(y, IND_TRAIN_BRANCH)
+        return y
+
+    def _regime_event(self, y: list[float], index: int, t: float) -> list[float]:
         if index == IND_STOP:
             self.halted = True
             return y
@@ -740,7 +781,7 @@ class VergeEscapement(Component):
             "closing speed below which contact is gentle (no impact)",
             min=0.0,
         ),
-        Variable("h_max", "parameter", "s", 1.0e-6, "largest internal RK4 step", min=0.0),
+        *INTEGRATION_VARIABLES,
         Variable(
             "center_distance",
             "parameter",
@@ -900,8 +941,8 @@ class VergeEscapement(Component):
     )
 
     def initialize(self, t0: float) -> None:
-        if self.h_max <= 0.0:
-            raise ComponentError("VergeEscapement: h_max must be positive")
+        self._control = step_control(self, STATE_SCALES)
+        self._h_next = 0.0
         data = escapement_data(self.center_distance, self.phi_local_start, self.pallet_inertia)
         k = VergeConstants(data, self.mu1, self.mu, self.spin, self.e_rest)
         self._held = HeldTrain(self.J_ref, self.T_ref, self.c_load, self.J_stot)
@@ -949,7 +990,8 @@ class VergeEscapement(Component):
             self._g_end = core.indicators(y)
             self._outputs(y)
             return
-        y, _, _, _ = advance(core, y, h, self.h_max)
+        done = advance(core, y, h, self._control, self._h_next)
+        y, self._h_next = done.y, done.h_next
         if core.halted:
             raise ComponentError(f"VergeEscapement: {core.fault}")
         if core.t_mark >= 0.0:

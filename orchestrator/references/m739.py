@@ -18,14 +18,21 @@ self-locking, verge disengaged, stop time reached, numerical failure).
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from components.event_integration import advance
+from components.event_integration import StepControl, advance
 from components.gear_train import INDEXING_AS_RUN, INDEXING_PHYSICAL, TrainPhysics
 from components.m739_data import M739, M739Data, rpm_to_rad_s
-from components.verge_escapement import REGIME_NAMES, VergeConstants, VergeCore
+from components.verge_escapement import REGIME_NAMES, STATE_SCALES, VergeConstants, VergeCore
+
+#: Relative local error tolerance of the monolithic integration: turns to arm move by less
+#: than 1e-7 relative when it is tightened tenfold (tests/test_m739_physics.py).
+REFERENCE_TOLERANCE = 1.0e-9
+#: The integration runs in stretches of this length (a stall or fault ends at the next).
+OUTPUT_CHUNK = 1.0e-3
 
 
 @dataclass
@@ -88,7 +95,6 @@ class _Monolithic(VergeCore):
             self.ff12_max = max(self.ff12_max, f12)
 
     def accept(self, y: list[float], t: float) -> None:
-        super().accept(y, t)
         self.record(y)
 
     def event(self, y: list[float], index: int, t: float) -> list[float]:
@@ -118,7 +124,7 @@ def run_m739(
     e_rest: float = M739.e_rest,
     t_stop: float = 0.2,
     indexing: int | str = "physical",
-    h_max: float = 2.0e-6,
+    tolerance: float = REFERENCE_TOLERANCE,
     sample_dt: float = 1.0e-5,
     data: M739Data = M739,
 ) -> M739Result:
@@ -136,7 +142,7 @@ def run_m739(
     train = TrainPhysics(data, mu=mu, omega=omega, indexing=code)
     k = VergeConstants(data, mu1, mu, omega, e_rest)
     core = _Monolithic(k, train, data.phi_start, phi_stop=data.phi_cut, log=log)
-    return simulate(core, data, events, t_stop, h_max, sample_dt)
+    return simulate(core, data, events, t_stop, tolerance, sample_dt)
 
 
 def simulate(
@@ -144,9 +150,9 @@ def simulate(
     data: M739Data,
     events: list[tuple[float, int, int, str]],
     t_stop: float,
-    h_max: float,
+    tolerance: float,
     sample_dt: float,
-    max_events: int = 2000,
+    max_events: int = 100_000,
 ) -> M739Result:
     """Run a monolithic verge-and-train model from rest until it halts or t_stop; never raises.
 
@@ -180,18 +186,31 @@ def simulate(
         cols["f23"].append(f23)
         cols["pn"].append(pn)
 
+    control = StepControl(tolerance, STATE_SCALES)
+    h_next = 0.0
     t = 0.0
     sample(t, y)
+    # Samples every sample_dt come from the solution between steps (dense output), so
+    # they do not shorten the steps.
+    count = [1]  # index of the next sample time, count * sample_dt
+
+    def observe(t0: float, t1: float, state_at: Callable[[float], list[float]]) -> None:
+        while count[0] * sample_dt - core.t_base <= t1:
+            t_abs = count[0] * sample_dt
+            sample(t_abs, state_at(t_abs - core.t_base))
+            count[0] += 1
+
     try:
-        while t < t_stop and not core.train_stuck:
-            h = min(sample_dt, t_stop - t)
+        while t < t_stop and not core.halted and not core.train_stuck:
+            h = min(OUTPUT_CHUNK, t_stop - t)
             core.t_base = t
-            y, _, t_ev, _ = advance(core, y, h, h_max, max_events=max_events)
+            done = advance(core, y, h, control, h_next, max_events=max_events, observe=observe)
+            y, h_next = done.y, done.h_next
             if core.halted:
-                t += t_ev if t_ev >= 0.0 else h
-                sample(t, y)
+                t += done.t_last_event if done.t_last_event >= 0.0 else h
                 break
             t += h
+        if t > cols["t"][-1]:
             sample(t, y)
     except (ArithmeticError, ValueError, RuntimeError) as exc:
         return _finish(core, y, t, False, f"numerical failure: {exc}", events, cols)

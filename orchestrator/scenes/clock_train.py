@@ -34,7 +34,7 @@ from components.verge_escapement import (
 )
 from components.verge_geometry import kinem
 from orchestrator.references import Reference
-from orchestrator.references.m739 import M739Result, _Monolithic, simulate
+from orchestrator.references.m739 import REFERENCE_TOLERANCE, M739Result, _Monolithic, simulate
 from orchestrator.scenario import Scene
 from orchestrator.scenes.m739 import (
     _names,
@@ -148,7 +148,7 @@ def run_clock_train(
     center_distance: float = M739.a,
     pallet_inertia: float = M739.ip,
     rotor_arming_angle: float = ARMING_ROTOR_ANGLE,
-    h_max: float = 2.0e-6,
+    tolerance: float = REFERENCE_TOLERANCE,
     sample_dt: float = 1.0e-5,
 ) -> M739Result:
     """Simulate the clock-train S&A from rest on the entrance face until arming or t_stop.
@@ -175,7 +175,7 @@ def run_clock_train(
     phi_stop = arming_phi(train, rotor_arming_angle)
     k = VergeConstants(data, mu1, mu, omega, e_rest)
     core = _ClockMonolithic(k, train, data.phi_start, phi_stop=phi_stop, log=log)
-    result = simulate(core, data, events, t_stop, h_max, sample_dt, max_events=20000)
+    result = simulate(core, data, events, t_stop, tolerance, sample_dt)
     result.handovers = train.handovers  # type: ignore[attr-defined]
     return result
 
