@@ -354,9 +354,12 @@ class TrainPhysics:
         self.i1r_sign = 1 if v * phi_ddot >= 0.0 else -1
 
     def branch_indicators(self, phi: float, phi_dot: float, phi_ddot: float) -> tuple[float]:
-        """Negative where the I1R branch no longer matches the motion (see update_i1r)."""
-        v = phi_dot if phi_dot != 0.0 else float(self.direction)
-        return (self.i1r_sign * v * phi_ddot,)
+        """Negative where the I1R branch no longer matches the motion (see update_i1r).
+
+        The direction of motion stands for the sign of the speed: a reversal is an event of
+        its own (which settles the branch), so this one crosses only where the acceleration
+        does and never races the speed indicator at a wheel stop."""
+        return (self.i1r_sign * self.direction * phi_ddot,)
 
 
 class _TrainModel(TrainLoadModel):

@@ -497,8 +497,9 @@ class VergeCore:
         train's own.  The report takes these signs from the last accepted step; switching
         them at the located instant is that rule's limit as the step goes to zero."""
         d = self.deriv(y)
-        v = y[3] if y[3] != 0.0 else float(self.s5)
-        return (self.ipr_sign * v * d[3], *self.train.branch_indicators(y[0], y[1], d[1]))
+        # s5 stands for the sign of psi_d (its zero is the verge-speed event), so this
+        # crosses only where the verge acceleration does.
+        return (self.ipr_sign * self.s5 * d[3], *self.train.branch_indicators(y[0], y[1], d[1]))
 
     def _switch_branch(self, y: list[float], index: int) -> list[float]:
         d = self.deriv(y)
