@@ -60,8 +60,8 @@ class Recorder:
         self._writer.writerow([repr(v) for v in values])
         try:
             finite = math.isfinite(math.fsum(values))
-        except OverflowError:  # finite values whose sum overflows
-            finite = True
+        except (OverflowError, ValueError):  # an overflowing sum, or inf - inf: look closer
+            finite = False
         if not finite:
             self._refuse_non_finite(values)
 

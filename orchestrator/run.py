@@ -10,6 +10,7 @@ from __future__ import annotations
 import platform
 import subprocess
 import time
+import warnings
 from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
@@ -201,6 +202,21 @@ def _analyse(
 ) -> tuple[dict[str, dict[str, Any]], dict[str, float]]:
     """Headline, energy residual, scene analysis, plot and error against the reference:
     each that fails adds a note saying why, and the others still count."""
+    with warnings.catch_warnings(), np.errstate(all="ignore"):
+        # non-finite results are reported as such (NaN, or a note): no numpy warnings
+        warnings.simplefilter("ignore", RuntimeWarning)
+        return _analyse_quietly(scene, out, recorder, data, status, compare_reference, notes)
+
+
+def _analyse_quietly(
+    scene: Scene,
+    out: Path,
+    recorder: Recorder,
+    data: np.ndarray,
+    status: str,
+    compare_reference: bool,
+    notes: list[str],
+) -> tuple[dict[str, dict[str, Any]], dict[str, float]]:
     header = recorder.header
     quantities: dict[str, dict[str, Any]] = {}
     with _noted(notes, "headline quantities", header):
