@@ -555,7 +555,11 @@ class _Loader:
                 f"than the limit {MAX_STEPS:.0e}: the run would not finish (--force to run it)",
             )
         order = node.get("order", list(fmus))
-        if not (isinstance(order, list) and sorted(order) == sorted(fmus)):
+        if not (
+            isinstance(order, list)
+            and all(isinstance(n, str) for n in order)
+            and sorted(order) == sorted(fmus)
+        ):
             raise self.fail("master.order", f"expected every instance once, from {sorted(fmus)}")
         options: dict[str, Any] = {}
         for k, (unit, _) in _MASTER_KEYS.items():
@@ -631,7 +635,7 @@ class _Loader:
                 raise self.fail(f"{key}.signal", "missing; expected '<instance>.<variable>'")
             signal = self.signal(entry["signal"], f"{key}.signal", fmus, None)
             reduce = entry.get("reduce", "final")
-            if reduce not in REDUCTIONS:
+            if not isinstance(reduce, str) or reduce not in REDUCTIONS:
                 raise self.fail(
                     f"{key}.reduce", f"unknown {reduce!r}; expected one of {list(REDUCTIONS)}"
                 )
@@ -641,7 +645,7 @@ class _Loader:
         if analysis is not None:
             from orchestrator.analyses import ANALYSES
 
-            if analysis not in ANALYSES:
+            if not isinstance(analysis, str) or analysis not in ANALYSES:
                 raise self.fail(
                     "report.analysis", f"unknown {analysis!r}; expected one of {sorted(ANALYSES)}"
                 )
@@ -650,7 +654,7 @@ class _Loader:
         if reference is not None:
             from orchestrator.references import REFERENCES
 
-            if reference not in REFERENCES:
+            if not isinstance(reference, str) or reference not in REFERENCES:
                 known = sorted(REFERENCES)
                 raise self.fail(
                     "report.reference", f"unknown {reference!r}; expected one of {known}"

@@ -165,8 +165,10 @@ def mutated_runnable(draw):
     """FMU parameters and inputs dropped or set to odd numbers: what a short run exercises."""
     name = draw(st.sampled_from(RUNNABLE))
     raw = json.loads(json.dumps(RAW[name]))
-    paths = [p for p in leaves(raw) if p[0] == "fmus" and len(p) == 4]
     for _ in range(draw(st.integers(1, 2))):
+        paths = [p for p in leaves(raw) if p[0] == "fmus" and len(p) == 4]
+        if not paths:
+            break
         path = draw(st.sampled_from(paths))
         value = draw(
             st.one_of(
