@@ -12,7 +12,10 @@ from orchestrator.errors import RunError, ScenarioError
 
 
 def main(argv: list[str] | None = None) -> int:
+    """Exit codes: 0 done, 1 a run or check failed, 2 bad input (one line on standard
+    error; the traceback only with --debug), 130/143 interrupted by SIGINT/SIGTERM."""
     parser = argparse.ArgumentParser(prog="mechcosim", description=__doc__)
+    parser.add_argument("--debug", action="store_true", help="show the full traceback of an error")
     sub = parser.add_subparsers(dest="command", required=True)
 
     p = sub.add_parser("run", help="run a scene and write its results")
@@ -26,10 +29,15 @@ def main(argv: list[str] | None = None) -> int:
     )
     p.add_argument("--output", type=Path, help="results directory (default: the scene's)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    p.add_argument(
+        "--force", action="store_true", help="run even a scene of more than 1e8 macro steps"
+    )
     p.set_defaults(handler=_run)
 
     p = sub.add_parser("check", help="validate a scenario file without running it")
     p.add_argument("scene", type=Path, nargs="+")
+    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
+    p.add_argument("--force", action="store_true", help="accept more than 1e8 macro steps")
     p.set_defaults(handler=_check)
 
     p = sub.add_parser("build", help="build FMUs (all if none named) into the cache")
@@ -96,13 +104,38 @@ def main(argv: list[str] | None = None) -> int:
     p.set_defaults(handler=_report)
 
     args = parser.parse_args(argv)
-    from fmus.build import BuildError
-
     try:
+        from fmus.build import BuildError
+
         return args.handler(args)
-    except (ScenarioError, RunError, BuildError) as exc:
-        print(f"error: {exc}", file=sys.stderr)
+    except KeyboardInterrupt:
+        if args.debug:
+            raise
+        print("interrupted", file=sys.stderr)
+        return 130
+    except (ScenarioError, RunError, BuildError, OSError, UnicodeError) as exc:
+        # bad input: a scene, a path, a cache, a results directory
+        if args.debug:
+            raise
+        print(f"error: {_one_line(exc)}", file=sys.stderr)
         return 2
+    except Exception as exc:  # noqa: BLE001 - the command line never shows a bare traceback
+        if args.debug:
+            raise
+        print(
+            f"error: {type(exc).__name__}: {_one_line(exc)} (--debug shows the traceback)",
+            file=sys.stderr,
+        )
+        return 1
+
+
+def _one_line(exc: BaseException) -> str:
+    """The first line of an error's message (FMU failures may carry a traceback after it)."""
+    if isinstance(exc, OSError) and exc.strerror:
+        where = f"{exc.filename}: " if exc.filename else ""
+        return f"{where}{exc.strerror}"
+    text = str(exc).strip()
+    return text.splitlines()[0] if text else type(exc).__name__
 
 
 def _overrides(pairs: list[str]) -> dict[str, object]:
@@ -131,14 +164,28 @@ def _floats(text: str) -> tuple[float, ...]:
 
 
 def _run(args: argparse.Namespace) -> int:
+    from orchestrator.interrupt import catching_signals
+
+    # From here on SIGINT/SIGTERM only set a flag: the run stops at a step boundary.
+    with catching_signals() as guard:
+        code = _run_guarded(args)
+    if guard.signum is not None:
+        return 128 + guard.signum
+    return code
+
+
+def _run_guarded(args: argparse.Namespace) -> int:
+    from orchestrator.cache import check_cache_dir
     from orchestrator.run import run_scene
     from orchestrator.scenario import load_scene
 
-    scene = load_scene(args.scene, _overrides(args.set))
+    check_cache_dir()
+    scene = load_scene(args.scene, _overrides(args.set), force=args.force)
     result = run_scene(scene, output_dir=args.output, show_progress=not args.no_progress)
-    print(
-        f"scene {scene.name}: {result.status}" + (f" — {result.message}" if result.message else "")
-    )
+    message = _one_line(RuntimeError(result.message)) if result.message else ""
+    if message != result.message.strip():
+        message += " (full message in summary.json)"
+    print(f"scene {scene.name}: {result.status}" + (f" — {message}" if message else ""))
     for name, q in result.headline.items():
         value = q["value"] if isinstance(q["value"], str) else f"{q['value']:.10g}"
         print(f"  {name:32s} {value} {q['unit']}")
@@ -146,6 +193,8 @@ def _run(args: argparse.Namespace) -> int:
         print(f"  {name:32s} {value:.4g}")
     for warning in result.stats.extra.get("warnings", []):
         print(f"  warning: {warning}")
+    if result.status == "interrupted" and result.interrupted_by is not None:
+        print(f"  interrupted at t = {result.time_reached:.9g} s (simulated)")
     s = result.stats
     print(
         f"  steps {s.steps}, doSteps {s.do_steps}, rejections {s.rejections}, "
@@ -156,10 +205,12 @@ def _run(args: argparse.Namespace) -> int:
 
 
 def _check(args: argparse.Namespace) -> int:
+    from orchestrator.cache import check_cache_dir
     from orchestrator.scenario import load_scene
 
+    check_cache_dir()
     for path in args.scene:
-        scene = load_scene(path)
+        scene = load_scene(path, _overrides(args.set), force=args.force)
         counts = f"{len(scene.fmus)} FMUs, {len(scene.connections)} connections"
         print(f"{path}: ok ({scene.name}, {counts})")
     return 0
@@ -168,7 +219,9 @@ def _check(args: argparse.Namespace) -> int:
 def _build(args: argparse.Namespace) -> int:
     from fmus.build import build_fmu
     from fmus.registry import FMU_WRAPPERS
+    from orchestrator.cache import check_cache_dir
 
+    check_cache_dir(args.dest)
     for name in args.names or sorted(FMU_WRAPPERS):
         print(build_fmu(name, args.dest, force=args.force))
     return 0
@@ -264,12 +317,16 @@ def _report(args: argparse.Namespace) -> int:
     if not summary_file.exists():
         print(f"error: {summary_file} not found: not a run directory", file=sys.stderr)
         return 2
-    summary = json.loads(summary_file.read_text())
-    print(
-        json.dumps(
-            {k: summary[k] for k in ("scene", "status", "message", "headline", "stats")}, indent=2
-        )
-    )
+    try:
+        summary = json.loads(summary_file.read_bytes().decode("utf-8"))
+    except (ValueError, UnicodeDecodeError) as exc:
+        print(f"error: {summary_file} is not a readable summary: {exc}", file=sys.stderr)
+        return 2
+    if not isinstance(summary, dict) or not isinstance(summary.get("status"), str):
+        print(f"error: {summary_file} is not a run summary (no status)", file=sys.stderr)
+        return 2
+    keys = ("scene", "status", "message", "time_reached", "headline", "notes", "stats")
+    print(json.dumps({k: summary[k] for k in keys if k in summary}, indent=2))
     return 0
 
 

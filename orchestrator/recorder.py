@@ -8,11 +8,15 @@ from __future__ import annotations
 
 import csv
 import json
+import math
+import os
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+
+from orchestrator.errors import RunError
 
 
 @dataclass
@@ -51,8 +55,24 @@ class Recorder:
         self._events_writer.writerow(["time", "subsystem", "from", "to"])
 
     def row(self, values: list[float]) -> None:
+        """Record one row; a value that is not finite is recorded, then ends the run."""
         self.rows.append(values)
         self._writer.writerow([repr(v) for v in values])
+        try:
+            finite = math.isfinite(math.fsum(values))
+        except (OverflowError, ValueError):  # an overflowing sum, or inf - inf: look closer
+            finite = False
+        if not finite:
+            self._refuse_non_finite(values)
+
+    def _refuse_non_finite(self, values: list[float]) -> None:
+        bad = [
+            (name, v) for name, v in zip(self.header, values, strict=True) if not math.isfinite(v)
+        ]
+        if bad:
+            name, value = bad[0]
+            more = f" (and {len(bad) - 1} more)" if len(bad) > 1 else ""
+            raise RunError(f"{name} is {value!r}, not finite{more}", values[0])
 
     def event(self, time: float, subsystem: str, before: str, after: str) -> None:
         self.events.append((time, subsystem, before, after))
@@ -61,13 +81,37 @@ class Recorder:
     def array(self) -> np.ndarray:
         return np.array(self.rows, dtype=float).reshape(-1, len(self.header))
 
+    def flush(self) -> None:
+        for f in (self._file, self._events_file):
+            if not f.closed:
+                f.flush()
+
     def close(self, summary: dict[str, Any]) -> None:
-        """Flush the series and write ``summary.json`` (status, stats, metadata, headline)."""
+        """Flush the series and write ``summary.json`` (status, stats, metadata, headline).
+
+        The summary is written to a temporary file and renamed, so a reader never sees half
+        of one.  Non-finite numbers are written as null (strict JSON has no NaN)."""
         for f in (self._file, self._events_file):
             if not f.closed:
                 f.close()
-        with open(self.directory / "summary.json", "w") as f:
-            json.dump(summary, f, indent=2, default=_jsonable)
+        target = self.directory / "summary.json"
+        partial = self.directory / "summary.json.part"
+        with open(partial, "w") as f:
+            json.dump(_finite_or_none(summary), f, indent=2, default=_jsonable, allow_nan=False)
+        os.replace(partial, target)
+
+
+def _finite_or_none(value: Any) -> Any:
+    """``value`` with every non-finite float (NaN, inf) replaced by None."""
+    if isinstance(value, dict):
+        return {k: _finite_or_none(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_finite_or_none(v) for v in value]
+    if isinstance(value, float | np.floating) and not math.isfinite(value):
+        return None
+    if isinstance(value, np.generic):
+        return value.item()
+    return value
 
 
 def _jsonable(value: Any) -> Any:

@@ -10,6 +10,9 @@ from __future__ import annotations
 import platform
 import subprocess
 import time
+import warnings
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from importlib import metadata
 from pathlib import Path
@@ -20,10 +23,12 @@ from tqdm import tqdm
 
 from fmus.build import build_fmu
 from orchestrator.accuracy import compare
-from orchestrator.analyses import ANALYSES, PLOTS, energy_residual, headline
+from orchestrator.analyses import ANALYSES, PLOTS, energy_residual, headline, missing_column
 from orchestrator.errors import RunError
 from orchestrator.fmu_instance import file_sha256
+from orchestrator.interrupt import Interrupted, SignalGuard, catching_signals, signal_name
 from orchestrator.masters import MASTERS
+from orchestrator.output_lock import OutputLock
 from orchestrator.recorder import Recorder, StepStats
 from orchestrator.references import REFERENCES, Reference
 from orchestrator.scenario import Scene
@@ -35,7 +40,7 @@ PROJECT_DIR = Path(__file__).resolve().parent.parent
 @dataclass
 class RunResult:
     scene: Scene
-    status: str  # "completed" or "failed"
+    status: str  # "completed", "failed" or "interrupted"
     message: str
     header: list[str]
     data: np.ndarray
@@ -45,6 +50,9 @@ class RunResult:
     output_dir: Path
     accuracy: dict[str, float] = field(default_factory=dict)
     metadata: dict[str, Any] = field(default_factory=dict)
+    time_reached: float | None = None  # simulated time the run got to
+    notes: list[str] = field(default_factory=list)  # what could not be computed, and why
+    interrupted_by: int | None = None  # the signal that interrupted the run
 
     def signal(self, name: str) -> np.ndarray:
         """Recorded column by name ('time' or '<instance>.<variable>')."""
@@ -61,14 +69,35 @@ def run_scene(
     show_progress: bool = True,
     compare_reference: bool = True,
 ) -> RunResult:
-    """Run ``scene`` and write its results under ``output_dir`` (default: the scene's)."""
+    """Run ``scene`` and write its results under ``output_dir`` (default: the scene's).
+
+    The directory is locked for the run (``OutputInUseError`` if another run holds it).
+    SIGINT/SIGTERM stop the run at the next step boundary with status "interrupted".
+    """
     out = Path(output_dir) if output_dir else scene.output_dir
+    with catching_signals() as guard, OutputLock(out):
+        return _run_locked(scene, out, cache_dir, show_progress, compare_reference, guard)
+
+
+def _run_locked(
+    scene: Scene,
+    out: Path,
+    cache_dir: Path | None,
+    show_progress: bool,
+    compare_reference: bool,
+    guard: SignalGuard,
+) -> RunResult:
     fmu_paths = fmu_files(scene, cache_dir)
     system = CoupledSystem(scene, fmu_paths)
-    recorder = Recorder(out, system.record_header)
+    try:
+        recorder = Recorder(out, system.record_header)
+    except OSError as exc:
+        system.close()
+        raise RunError(f"cannot write results in {out}: {exc.strerror or exc}") from None
     stats = StepStats()
     meta = _metadata(scene, fmu_paths)
     status, message = "completed", ""
+    notes: list[str] = []
     bar = tqdm(
         total=scene.stop - scene.start,
         unit="s(sim)",
@@ -78,8 +107,11 @@ def run_scene(
         bar_format="{l_bar}{bar}| {n:.4g}/{total:.4g} s [{elapsed}<{remaining}]",
     )
     last = [scene.start, time.perf_counter()]
+    reached = [scene.start]
 
     def progress(t: float) -> None:
+        reached[0] = t
+        guard.check()  # between macro steps: no FMU call is under way
         now = time.perf_counter()
         if now - last[1] > 0.2:  # keep the bar off the hot path
             bar.update(t - last[0])
@@ -87,37 +119,56 @@ def run_scene(
 
     start = time.perf_counter()
     try:
+        guard.check()
         system.initialize()
+        guard.check()
         MASTERS[scene.master.algorithm](system, scene, recorder, stats, progress)
     except RunError as exc:
         status, message = "failed", str(exc)
+        if exc.time is not None:
+            reached[0] = exc.time
+    except Interrupted as exc:
+        status = "interrupted"
+        if recorder.rows and recorder.rows[-1][0] < reached[0]:
+            try:  # the values at the step boundary reached (a thinned record may lack it)
+                recorder.row(system.record_row(reached[0]))
+            except RunError:
+                pass
+        message = (
+            f"{exc}: stopped at t = {reached[0]:.9g} s (simulated); everything up to there is kept"
+        )
     finally:
         stats.wall_time = time.perf_counter() - start
         bar.close()
         system.close()
+    recorder.flush()
     data = recorder.array()
-    quantities = headline(scene, recorder.header, data)
-    residual = energy_residual(recorder.header, data)
-    if residual is not None:
-        quantities["energy_residual"] = residual
-    if scene.analysis and status == "completed":
-        quantities.update(
-            ANALYSES[scene.analysis](scene, recorder.header, data, scene.analysis_options)
-        )
-        if scene.analysis in PLOTS and len(data) > 1:
-            PLOTS[scene.analysis](scene, recorder.header, data, out / f"{scene.name}.png")
+    quantities: dict[str, dict[str, Any]] = {}
     accuracy: dict[str, float] = {}
-    if scene.reference and status == "completed" and compare_reference:
-        ref = reference_of(scene)
-        accuracy = compare(recorder.header, data, recorder.events, quantities, ref)
-        accuracy["reference_wall_time"] = ref.wall_time
+    try:
+        # No FMU is alive any more: a signal may now stop the analyses where it lands.
+        with guard.raise_at_once():
+            quantities, accuracy = _analyse(
+                scene, out, recorder, data, status, compare_reference, notes
+            )
+    except Interrupted as exc:
+        if status == "completed":
+            status = "interrupted"
+            message = f"{exc} after the run ended (t = {reached[0]:.9g} s): analyses skipped"
+    if guard.signum is not None and status == "completed":
+        status = "interrupted"
+        message = f"interrupted by {signal_name(guard.signum)} after the run ended"
+    if notes:
+        stats.extra.setdefault("warnings", []).extend(notes)
     recorder.close(
         {
             "scene": scene.name,
             "status": status,
             "message": message,
+            "time_reached": reached[0],
             "headline": quantities,
             "accuracy": accuracy,
+            "notes": notes,
             "stats": stats.as_dict(),
             "metadata": meta,
         }
@@ -134,7 +185,75 @@ def run_scene(
         out,
         accuracy,
         meta,
+        reached[0],
+        notes,
+        guard.signum if status == "interrupted" else None,
     )
+
+
+def _analyse(
+    scene: Scene,
+    out: Path,
+    recorder: Recorder,
+    data: np.ndarray,
+    status: str,
+    compare_reference: bool,
+    notes: list[str],
+) -> tuple[dict[str, dict[str, Any]], dict[str, float]]:
+    """Headline, energy residual, scene analysis, plot and error against the reference:
+    each that fails adds a note saying why, and the others still count."""
+    with warnings.catch_warnings(), np.errstate(all="ignore"):
+        # non-finite results are reported as such (NaN, or a note): no numpy warnings
+        warnings.simplefilter("ignore", RuntimeWarning)
+        return _analyse_quietly(scene, out, recorder, data, status, compare_reference, notes)
+
+
+def _analyse_quietly(
+    scene: Scene,
+    out: Path,
+    recorder: Recorder,
+    data: np.ndarray,
+    status: str,
+    compare_reference: bool,
+    notes: list[str],
+) -> tuple[dict[str, dict[str, Any]], dict[str, float]]:
+    header = recorder.header
+    quantities: dict[str, dict[str, Any]] = {}
+    with _noted(notes, "headline quantities", header):
+        quantities.update(headline(scene, header, data))
+    with _noted(notes, "energy residual", header):
+        residual = energy_residual(header, data)
+        if residual is not None:
+            quantities["energy_residual"] = residual
+    if scene.analysis and status == "completed":
+        with _noted(notes, f"analysis {scene.analysis!r}", header):
+            quantities.update(ANALYSES[scene.analysis](scene, header, data, scene.analysis_options))
+        if scene.analysis in PLOTS and len(data) > 1:
+            with _noted(notes, f"plot of {scene.analysis!r}", header):
+                PLOTS[scene.analysis](scene, header, data, out / f"{scene.name}.png")
+    accuracy: dict[str, float] = {}
+    if scene.reference and status == "completed" and compare_reference:
+        with _noted(notes, f"reference {scene.reference!r}", header):
+            ref = reference_of(scene)
+            accuracy = compare(header, data, recorder.events, quantities, ref, notes)
+            accuracy["reference_wall_time"] = ref.wall_time
+    return quantities, accuracy
+
+
+@contextmanager
+def _noted(notes: list[str], what: str, header: list[str]) -> Iterator[None]:
+    """Run a post-run stage; an error becomes a one-line note instead of ending the run."""
+    try:
+        yield
+    except KeyError as exc:
+        column = missing_column(exc, header)
+        if column is not None:
+            notes.append(f"{what} not computed: it needs {column} recorded (output.record)")
+        else:
+            notes.append(f"{what} not computed: missing {exc.args[0]!r}")
+    except Exception as exc:  # noqa: BLE001 - any failure of an analysis is reported, not raised
+        text = str(exc).strip().splitlines()[0] if str(exc).strip() else ""
+        notes.append(f"{what} not computed: {type(exc).__name__}: {text}".rstrip(": "))
 
 
 def fmu_files(scene: Scene, cache_dir: Path | None = None) -> dict[str, Path]:

@@ -40,6 +40,16 @@ _MASTER_KEYS: dict[str, tuple[str | None, bool]] = {
 # Master settings that take one of a few words.
 _MASTER_CHOICES: dict[str, tuple[str, ...]] = {"input_hold": ("start", "midpoint")}
 
+#: More macro steps than this cannot finish in any sensible time: refused unless forced.
+MAX_STEPS = 1e8
+
+#: Parameters that mean one physical quantity wherever they appear: when a scene holds
+#: several of these components, their values of the parameter must agree.  Keyed by our
+#: components' names (fmus.registry), so it holds for every scene of the family.
+SHARED_PARAMETERS: tuple[tuple[str, frozenset[str], str], ...] = (
+    ("spin", frozenset({"GearTrain", "ClockGearTrain", "VergeEscapement"}), "the fuze spin rate"),
+)
+
 
 @dataclass(frozen=True)
 class FmuSpec:
@@ -137,7 +147,10 @@ def component_class(fmu_name: str) -> type[Component]:
 
 
 def load_scene(
-    path: str | Path, overrides: dict[str, Any] | None = None, cache_dir: Path | None = None
+    path: str | Path,
+    overrides: dict[str, Any] | None = None,
+    cache_dir: Path | None = None,
+    force: bool = False,
 ) -> Scene:
     """Read, validate and convert a scenario file; ``overrides`` patch the raw TOML first.
 
@@ -145,24 +158,52 @@ def load_scene(
     a variable name after ``parameters.`` or ``inputs.`` may itself hold dots
     ("fmus.c.parameters.inertia1.J").  The FMUs the scene names are built (ours, into
     ``cache_dir``) or read, so that everything is checked against their model descriptions.
+    ``force`` accepts a run of more than ``MAX_STEPS`` macro steps.
     """
     path = Path(path)
-    try:
-        raw = tomllib.loads(path.read_text())
-    except FileNotFoundError:
-        raise ScenarioError(path, "", "file not found") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise ScenarioError(path, "", f"not valid TOML: {exc}") from None
+    raw = read_toml(path)
     for dotted, value in (overrides or {}).items():
         _set_dotted(raw, dotted, value)
-    return _Loader(path, raw, cache_dir).scene()
+    return _Loader(path, raw, cache_dir, force).scene()
+
+
+def read_toml(path: Path) -> dict[str, Any]:
+    """The parsed file, or a ScenarioError saying in one line why it cannot be read."""
+    try:
+        text = path.read_bytes().decode("utf-8")
+    except FileNotFoundError:
+        raise ScenarioError(path, "", "file not found") from None
+    except IsADirectoryError:
+        raise ScenarioError(path, "", "is a directory; expected a scenario file (.toml)") from None
+    except UnicodeDecodeError as exc:
+        raise ScenarioError(
+            path, "", f"not UTF-8 text (byte {exc.start}): expected a TOML scenario file"
+        ) from None
+    except OSError as exc:
+        raise ScenarioError(path, "", f"cannot read: {exc.strerror or exc}") from None
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ScenarioError(path, "", f"not valid TOML: {exc}") from None
+    except RecursionError:
+        raise ScenarioError(
+            path, "", "not a scenario: tables or arrays nested too deeply"
+        ) from None
 
 
 def _set_dotted(raw: dict[str, Any], dotted: str, value: Any) -> None:
-    *parents, last = _split_key(dotted)
+    parts = _split_key(dotted)
+    if not all(parts):
+        raise ScenarioError("--set", dotted, "expected a dotted key such as master.step")
+    *parents, last = parts
     node = raw
-    for key in parents:
+    for depth, key in enumerate(parents):
         node = node.setdefault(key, {})
+        if not isinstance(node, dict):
+            where = ".".join(parents[: depth + 1])
+            raise ScenarioError(
+                "--set", dotted, f"{where} is a value ({node!r}), not a table: cannot set {last!r}"
+            )
     node[last] = value
 
 
@@ -175,8 +216,10 @@ def _split_key(dotted: str) -> list[str]:
 
 
 class _Loader:
-    def __init__(self, path: Path, raw: dict[str, Any], cache_dir: Path | None) -> None:
-        self.path, self.raw, self.cache_dir = path, raw, cache_dir
+    def __init__(
+        self, path: Path, raw: dict[str, Any], cache_dir: Path | None, force: bool = False
+    ) -> None:
+        self.path, self.raw, self.cache_dir, self.force = path, raw, cache_dir, force
 
     def fail(self, key: str, message: str) -> ScenarioError:
         return ScenarioError(self.path, key, message)
@@ -194,9 +237,12 @@ class _Loader:
 
     def quantity(self, value: Any, key: str, unit: str) -> float:
         try:
-            return to_si(value, unit)
-        except ValueError as exc:
+            si = to_si(value, unit)
+        except (ValueError, TypeError, ArithmeticError) as exc:
             raise self.fail(key, f"{exc} (expected a value in {unit})") from None
+        if not math.isfinite(si):
+            raise self.fail(key, f"expected a finite value, got {value!r}")
+        return si
 
     def string(
         self, node: dict[str, Any], key: str, dotted: str, default: str | None = None
@@ -228,6 +274,7 @@ class _Loader:
         if not stop > start:
             raise self.fail("scene.stop", f"must be later than scene.start ({start} s), got {stop}")
         fmus = self.fmus(self.table(raw["fmus"], "fmus"))
+        self.shared_parameters(fmus)
         stop_when = self.stop_when(head["stop_when"], fmus) if "stop_when" in head else None
         connections = self.connections(raw.get("connections", []), fmus)
         master = self.master(self.table(raw["master"], "master"), fmus, stop - start)
@@ -236,6 +283,7 @@ class _Loader:
         )
         report = self.table(raw.get("report", {}), "report")
         headline, analysis, options, reference, error_bound = self.report(report, fmus)
+        self.report_needs(headline, analysis, reference, options, fmus, record)
         sweep = self.sweep(raw["sweep"], fmus) if "sweep" in raw else None
         return Scene(
             path=self.path,
@@ -257,6 +305,30 @@ class _Loader:
             error_bound=error_bound,
             sweep=sweep,
         )
+
+    def shared_parameters(self, fmus: dict[str, FmuSpec]) -> None:
+        """Parameters that are one quantity across components (SHARED_PARAMETERS) agree."""
+        for name, components, meaning in SHARED_PARAMETERS:
+            values = []
+            for instance, spec in fmus.items():
+                if spec.component not in components:
+                    continue
+                var = spec.model.variables.get(name)
+                if var is None or var.causality != "parameter":
+                    continue
+                try:
+                    value = float(spec.parameters.get(name, var.start))
+                except (TypeError, ValueError):
+                    continue
+                values.append((instance, value, var.unit or ""))
+            for instance, value, unit in values[1:]:
+                first, v0, _ = values[0]
+                if not math.isclose(value, v0, rel_tol=1e-9, abs_tol=1e-12):
+                    raise self.fail(
+                        f"fmus.{instance}.parameters.{name}",
+                        f"{value:.9g} {unit} differs from {first}'s {v0:.9g} {unit}: "
+                        f"{name} is {meaning}, one value for every FMU of the scene",
+                    )
 
     def stop_when(self, node: Any, fmus: dict[str, FmuSpec]) -> StopCondition:
         key = "scene.stop_when"
@@ -319,6 +391,10 @@ class _Loader:
             return component, build_fmu(component, self.cache_dir)
         except BuildError as exc:
             raise self.fail(f"{key}.component", str(exc)) from None
+        except OSError as exc:
+            raise self.fail(
+                f"{key}.component", f"cannot build into the FMU cache: {exc.strerror or exc}"
+            ) from None
 
     def values(self, node: Any, key: str, model: ModelInfo) -> dict[str, Any]:
         """Values given for parameters or inputs (``key`` ends in which), in SI, checked
@@ -472,8 +548,18 @@ class _Loader:
             raise self.fail("master.step", f"must be positive, got {step} s")
         if step > duration:
             raise self.fail("master.step", f"{step} s is longer than the run ({duration} s)")
+        if duration / step > MAX_STEPS and algorithm != "regime-aware" and not self.force:
+            raise self.fail(
+                "master.step",
+                f"{step:g} s over {duration:g} s is {duration / step:.3g} macro steps, more "
+                f"than the limit {MAX_STEPS:.0e}: the run would not finish (--force to run it)",
+            )
         order = node.get("order", list(fmus))
-        if not (isinstance(order, list) and sorted(order) == sorted(fmus)):
+        if not (
+            isinstance(order, list)
+            and all(isinstance(n, str) for n in order)
+            and sorted(order) == sorted(fmus)
+        ):
             raise self.fail("master.order", f"expected every instance once, from {sorted(fmus)}")
         options: dict[str, Any] = {}
         for k, (unit, _) in _MASTER_KEYS.items():
@@ -493,6 +579,20 @@ class _Loader:
                 if not value > 0.0:
                     raise self.fail(f"master.{k}", f"must be positive, got {value}")
                 options[k] = value
+        low, high = options.get("min_step"), options.get("max_step")
+        if low is not None and high is not None and high < low:
+            raise self.fail(
+                "master.max_step", f"{high:g} s is less than master.min_step ({low:g} s)"
+            )
+        if algorithm == "regime-aware":
+            largest = options.get("max_step", 100.0 * step)
+            if duration / largest > MAX_STEPS and not self.force:
+                raise self.fail(
+                    "master.max_step" if "max_step" in options else "master.step",
+                    f"steps of at most {largest:g} s over {duration:g} s are at least "
+                    f"{duration / largest:.3g} macro steps, more than the limit "
+                    f"{MAX_STEPS:.0e}: the run would not finish (--force to run it)",
+                )
         return MasterSpec(algorithm, step, tuple(order), options)
 
     def output(self, node: dict[str, Any], fmus: dict[str, FmuSpec], name: str):
@@ -518,6 +618,8 @@ class _Loader:
         directory = node.get("directory", f"runs/{name}")
         if not isinstance(directory, str):
             raise self.fail("output.directory", f"expected a path string, got {directory!r}")
+        if not directory.strip() or "\0" in directory:
+            raise self.fail("output.directory", f"expected a directory path, got {directory!r}")
         return record, every, Path(directory)
 
     def report(self, node: dict[str, Any], fmus: dict[str, FmuSpec]):
@@ -533,7 +635,7 @@ class _Loader:
                 raise self.fail(f"{key}.signal", "missing; expected '<instance>.<variable>'")
             signal = self.signal(entry["signal"], f"{key}.signal", fmus, None)
             reduce = entry.get("reduce", "final")
-            if reduce not in REDUCTIONS:
+            if not isinstance(reduce, str) or reduce not in REDUCTIONS:
                 raise self.fail(
                     f"{key}.reduce", f"unknown {reduce!r}; expected one of {list(REDUCTIONS)}"
                 )
@@ -543,7 +645,7 @@ class _Loader:
         if analysis is not None:
             from orchestrator.analyses import ANALYSES
 
-            if analysis not in ANALYSES:
+            if not isinstance(analysis, str) or analysis not in ANALYSES:
                 raise self.fail(
                     "report.analysis", f"unknown {analysis!r}; expected one of {sorted(ANALYSES)}"
                 )
@@ -552,7 +654,7 @@ class _Loader:
         if reference is not None:
             from orchestrator.references import REFERENCES
 
-            if reference not in REFERENCES:
+            if not isinstance(reference, str) or reference not in REFERENCES:
                 known = sorted(REFERENCES)
                 raise self.fail(
                     "report.reference", f"unknown {reference!r}; expected one of {known}"
@@ -561,6 +663,59 @@ class _Loader:
         if isinstance(bound, bool) or not isinstance(bound, int | float) or not bound > 0:
             raise self.fail("report.error_bound", f"expected a positive number, got {bound!r}")
         return headline, analysis, dict(options), reference, float(bound)
+
+    def report_needs(
+        self,
+        headline: dict[str, HeadlineSpec],
+        analysis: str | None,
+        reference: str | None,
+        options: dict[str, Any],
+        fmus: dict[str, FmuSpec],
+        record: tuple[tuple[str, str], ...],
+    ) -> None:
+        """What the report reads is recorded, and its options are ones it knows."""
+        from orchestrator.analyses import NEEDS, Needs
+
+        recorded = {f"{i}.{v}" for i, v in record}
+        for hname, spec in headline.items():
+            if ".".join(spec.signal) not in recorded:
+                raise self.fail(
+                    f"report.headline.{hname}.signal",
+                    f"{'.'.join(spec.signal)} is not recorded; add it to output.record",
+                )
+        users = [n for n in dict.fromkeys((analysis, reference)) if n is not None]
+        needs = [NEEDS.get(n, Needs()) for n in users]
+        known = sorted({o for need in needs for o in need.options})
+        for key in options:
+            if key not in known:
+                if not users:
+                    raise self.fail(
+                        f"report.options.{key}",
+                        "options are read by report.analysis or report.reference; none named",
+                    )
+                raise self.fail(
+                    f"report.options.{key}",
+                    f"unknown key for {' and '.join(map(repr, users))}; expected one of {known}",
+                )
+        if analysis is None:
+            return
+        need = NEEDS.get(analysis, Needs())
+        for role in need.roles:
+            if role.option and role.option in options:
+                value = options[role.option]
+                if not isinstance(value, str) or value not in fmus:
+                    raise self.fail(
+                        f"report.options.{role.option}",
+                        f"expected an FMU instance of the scene, one of {sorted(fmus)}; "
+                        f"got {value!r}",
+                    )
+        missing = need.missing_signals(fmus, options, recorded)
+        if missing:
+            raise self.fail(
+                "output.record",
+                f"analysis {analysis!r} needs {', '.join(missing)} recorded; add "
+                f"{'it' if len(missing) == 1 else 'them'} to output.record",
+            )
 
     def sweep(self, node: Any, fmus: dict[str, FmuSpec]) -> SweepSpec:
         node = self.table(node, "sweep")

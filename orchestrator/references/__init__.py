@@ -22,6 +22,8 @@ class Reference:
     signals: Callable[[np.ndarray], dict[str, np.ndarray]]  # "inst.var" -> values at times
     events: list[tuple[float, str, str, str]] = field(default_factory=list)
     wall_time: float = 0.0
+    #: times the signals are known for (None: any time); outside, they are not compared
+    t_range: tuple[float, float] | None = None
 
 
 #: Scene references: (scene) -> Reference.

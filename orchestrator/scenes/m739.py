@@ -125,14 +125,18 @@ def reference_from(result: Any, train: str, verge: str) -> Reference:
 
     def signals(times: np.ndarray) -> dict[str, np.ndarray]:
         # The escape-wheel angle is continuous (speeds jump at impacts): it is the trajectory
-        # compared; past the reference's end the comparison holds its last value.
+        # compared, within the reference's time range (t_range).
+        if "t" not in s or len(s["t"]) == 0:
+            return {}  # the reference has no time series (e.g. no spin: it never moved)
         return {f"{train}.phi": np.interp(times, s["t"], s["phi"])}
+
+    t_range = (float(s["t"][0]), float(s["t"][-1])) if len(s.get("t", ())) else None
 
     events = [
         (te, verge, REGIME_NAMES.get(a, str(a)), REGIME_NAMES.get(b, str(b)))
         for te, a, b in result.regime_log
     ]
-    return Reference(headline=headline, signals=signals, events=events)
+    return Reference(headline=headline, signals=signals, events=events, t_range=t_range)
 
 
 def plot(scene: Scene, header: list[str], data: np.ndarray, path: Path) -> None:

@@ -243,7 +243,7 @@ def analyse(
     n = _complete_cycles(t[-1], fs.period)
     out: dict[str, dict[str, Any]] = {}
     if n == 0:
-        return out
+        raise ValueError(_no_cycle(t[-1], fs.period))
     startup = int(options.get("startup_cycles", 1))
     normal = _normal_cycles(n, startup)
     regime = thesis_regime(
@@ -282,6 +282,13 @@ def analyse(
             np.diff(np.interp([0, n * fs.period], t, col[ext]))[0] / n, "J"
         )
     return out
+
+
+def _no_cycle(duration: float, period: float) -> str:
+    return (
+        f"the run covers {duration:.6g} s, less than one crank cycle ({period:.6g} s): "
+        "no per-cycle quantity to compute"
+    )
 
 
 def time_mean(t: np.ndarray, x: np.ndarray, sel: np.ndarray) -> float:
@@ -471,6 +478,8 @@ def reference_quantities(res, fs: FeedScene, duration: float, options: dict[str,
     """Headline values of a reference run under the names ``analyse`` uses."""
     startup = int(options.get("startup_cycles", 1))
     n = _complete_cycles(duration, fs.period)
+    if n == 0:
+        raise ValueError(_no_cycle(duration, fs.period))
     cycles = res.cycles[:n]
     normal = _normal_cycles(n, startup)
     s = res.series
@@ -539,4 +548,5 @@ def reference(scene: Scene) -> Reference:
         return {name: np.interp(rel, ref_t, values) for name, values in columns.items()}
 
     events = [(t + scene.start, *rest) for t, *rest in _subsystem_events(res, fs, duration)]
-    return Reference(headline=headline, signals=signals, events=events)
+    t_range = (scene.start + float(ref_t[0]), scene.start + float(ref_t[-1]))
+    return Reference(headline=headline, signals=signals, events=events, t_range=t_range)

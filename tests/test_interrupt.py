@@ -1,0 +1,111 @@
+"""SIGINT/SIGTERM at any moment of ``mechcosim run``: the run stops at a step boundary,
+writes summary.json with status "interrupted" and the simulated time reached, keeps its
+CSV files readable and exits 130 / 143, never crashing in an FMU."""
+
+from __future__ import annotations
+
+import csv
+import json
+import os
+import random
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from orchestrator.interrupt import Interrupted, SignalGuard, catching_signals
+from orchestrator.output_lock import LOCK_NAME
+
+PROJECT_DIR = Path(__file__).resolve().parent.parent
+M739 = PROJECT_DIR / "scenarios" / "m739.toml"
+
+
+def interrupt_run(out: Path, delay: float, sig: int) -> tuple[int, str, float]:
+    """Start ``mechcosim run scenarios/m739.toml``, send ``sig`` after ``delay`` seconds;
+    (exit code, stderr, seconds from the signal to the exit)."""
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "orchestrator.cli", "run", str(M739), "--no-progress"]
+        + ["--output", str(out)],
+        cwd=PROJECT_DIR,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    time.sleep(delay)
+    sent = time.perf_counter()
+    proc.send_signal(sig)
+    try:
+        _, err = proc.communicate(timeout=120)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        proc.communicate()
+        raise AssertionError(f"no exit within 120 s of {signal.Signals(sig).name}") from None
+    return proc.returncode, err, time.perf_counter() - sent
+
+
+def assert_interrupted(out: Path, code: int, err: str, sig: int, delay: float) -> float:
+    what = f"{signal.Signals(sig).name} after {delay:.2f} s"
+    assert code == 128 + sig, f"{what}: exit {code}; stderr: {err[-2000:]}"
+    assert "Traceback" not in err, f"{what}: {err[-2000:]}"
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == "interrupted", what
+    assert signal.Signals(sig).name in summary["message"], summary["message"]
+    reached = summary["time_reached"]
+    assert 0.0 <= reached <= 0.2, what
+    with open(out / "timeseries.csv", newline="") as f:
+        rows = list(csv.reader(f))
+    assert rows and rows[0][0] == "time", what
+    data = np.array(rows[1:], dtype=float).reshape(-1, len(rows[0]))
+    if len(data):  # every row whole and in time order, the last at the time reached
+        assert np.all(np.diff(data[:, 0]) >= 0.0), what
+        assert data[-1, 0] == pytest.approx(reached, abs=1e-12), what
+    with open(out / "events.csv", newline="") as f:
+        assert next(csv.reader(f)) == ["time", "subsystem", "from", "to"], what
+    assert not (out / LOCK_NAME).exists(), what
+    return reached
+
+
+def test_guard_turns_a_signal_into_a_flag_checked_between_steps() -> None:
+    with catching_signals() as guard:
+        os.kill(os.getpid(), signal.SIGTERM)  # delivered at once to this (main) thread
+        assert guard.signum == signal.SIGTERM
+        with pytest.raises(Interrupted) as info:
+            guard.check()
+    assert info.value.exit_code == 143
+    assert signal.getsignal(signal.SIGTERM) is signal.SIG_DFL  # restored
+
+
+def test_guard_raises_at_once_only_when_asked() -> None:
+    guard = SignalGuard()
+    guard.handle(signal.SIGINT, None)  # flag only
+    guard = SignalGuard()
+    with pytest.raises(Interrupted), guard.raise_at_once():
+        guard.handle(signal.SIGINT, None)
+
+
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
+def test_run_interrupted_at_a_random_moment(tmp_path: Path, sig: int) -> None:
+    delay = random.uniform(0.5, 4.0)
+    code, err, latency = interrupt_run(tmp_path / "out", delay, sig)
+    assert_interrupted(tmp_path / "out", code, err, sig, delay)
+    assert latency < 30.0
+
+
+@pytest.mark.slow
+def test_run_interrupted_twenty_times(tmp_path: Path) -> None:
+    """20 interrupts at random moments of a 20-30 s run (loading, initialization, the run,
+    the reference and analyses), alternately SIGINT and SIGTERM."""
+    seed = random.randrange(1 << 30)
+    rng = random.Random(seed)
+    reached = []
+    for k in range(20):
+        sig = signal.SIGINT if k % 2 == 0 else signal.SIGTERM
+        delay = rng.uniform(0.3, 18.0)
+        out = tmp_path / f"run{k}"
+        code, err, _ = interrupt_run(out, delay, sig)
+        reached.append(assert_interrupted(out, code, err, sig, delay) if code else None)
+    print(f"seed {seed}: simulated times reached {reached}")
