@@ -121,6 +121,7 @@ class RegimeAwareMaster:
         self.out_scale = {s: 0.0 for s in self.outputs}
         self.ratio = 0.0  # error ratio of the last corrected trial
         self.predicted: list[list[float]] = []  # end values the last corrected trial used
+        self.left_row: list[float] | None = None  # values just before the last landed switch
 
     # -- helpers ----------------------------------------------------------------------
     def snapshot(self) -> _Snapshot:
@@ -329,6 +330,7 @@ class RegimeAwareMaster:
         last_ratio = None
         stalled = 0
         for _ in range(200):
+            self.left_row = None  # set by _correct_landing for this very trial
             self.trial(t, h)
             te = self.switch_time(t, h, before)
             if te is not None and cfg.midpoint:
@@ -385,8 +387,13 @@ class RegimeAwareMaster:
             self._restore(state)
             self.trial(t, h_left)
             predicted = [list(v) for v in self.system.values]
+            # Kept as the recorded values just before the switch: the accepted step's error
+            # test bounds this predictor's error by the tolerance, and retaking the step
+            # only to record them cost four trials per switch.
+            self.left_row = self.system.record_row(t + h_left)
         else:
             predicted = before.values
+            self.left_row = None
         self.corrected_trial(t, h, before, state, predicted, compare=crossed)
         return self.switch_time(t, h, before)
 
@@ -402,6 +409,8 @@ class RegimeAwareMaster:
         h_left = te - t - 0.5 * self.cfg.event_tolerance
         if h_left <= 0.0:
             return None
+        if self.cfg.midpoint and self.left_row is not None:
+            return self.left_row  # taken on the way to this step (_correct_landing)
         accepted = self.predicted
         self._rollback(state)
         self.trial(t, h_left)
