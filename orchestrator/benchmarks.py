@@ -191,6 +191,52 @@ def _cosim(scene_file: str, overrides: dict[str, object], quantity: str, truth: 
     return result.stats.wall_time, err, result
 
 
+def _sweep_throughput(scene_file: str = "lever_rate_vs_load.toml") -> list[tuple[str, float, str]]:
+    """Throughput of a parameter sweep on 2 workers against 1: process pool and Dask."""
+    from dask.distributed import LocalCluster
+
+    from orchestrator.parameter_sweep import run_sweep
+
+    out = Path("runs") / "bench_speed_sweep"
+    walls: dict[tuple[str, int], float] = {}
+    tables = []
+    for workers in (1, 2):
+        t0 = time.perf_counter()
+        tables.append(run_sweep(SCENARIOS / scene_file, out / f"pool{workers}", workers).rows)
+        walls[("pool", workers)] = time.perf_counter() - t0
+        with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True) as cluster:
+            t0 = time.perf_counter()
+            rows = run_sweep(
+                SCENARIOS / scene_file, out / f"dask{workers}", None, cluster.scheduler_address
+            ).rows
+            walls[("dask", workers)] = time.perf_counter() - t0
+        tables.append(rows)
+    same = all(_same_rows(tables[0], other) for other in tables[1:])
+    print(
+        f"sweep {scene_file}: pool {walls[('pool', 1)]:.1f} s / {walls[('pool', 2)]:.1f} s, "
+        f"Dask {walls[('dask', 1)]:.1f} s / {walls[('dask', 2)]:.1f} s on 1 / 2 workers; "
+        f"same numbers: {'yes' if same else 'NO'}"
+    )
+    return [
+        (
+            f"sweep, process pool: 2 workers / 1 ({scene_file})",
+            walls[("pool", 1)] / walls[("pool", 2)],
+            ">= 1.8",
+        ),
+        (
+            f"sweep, Dask: 2 workers / 1 ({scene_file})",
+            walls[("dask", 1)] / walls[("dask", 2)],
+            ">= 1.8",
+        ),
+    ]
+
+
+def _same_rows(a: list[dict], b: list[dict]) -> bool:
+    """The sweep tables agree in every quantity (wall times aside)."""
+    strip = lambda rows: [{k: v for k, v in r.items() if "wall" not in k} for r in rows]  # noqa: E731
+    return repr(strip(a)) == repr(strip(b))
+
+
 def speed() -> None:
     """Run time against the monolithic models and across tolerances, all measured here.
 
@@ -221,6 +267,7 @@ def speed() -> None:
     t_ref = result.accuracy["reference_wall_time"]
     print(f"press feed Run 1: {wall:.2f} s, trajectory error {err:.1e}; reference {t_ref:.2f} s")
     rows.append(("press feed Run 1: co-simulation / monolithic", wall / t_ref, "<= 2"))
+    rows.extend(_sweep_throughput())
     print(f"\n{'ratio':58s} {'measured':>9s} {'target':>7s}")
     for what, ratio, target in rows:
         print(f"{what:58s} {ratio:9.2f} {target:>7s}")
