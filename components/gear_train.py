@@ -1,6 +1,8 @@
 """M739 gear train: eccentric rotor, gear/pinion set 2, escape wheel/pinion 3 (1 DOF).
 
-Physics of Lowen & Tepper (1982), note ``models/sa_verge_escapement.md`` §1.2, §2.4, §4.
+Physics of Lowen & Tepper (1982), *Computer Simulation of Artillery S&A Mechanism (Involute
+Gear Train and Straight-Sided Verge Runaway Escapement)*: the spin drive, the moment
+equations B96, B144, B171 and their reduction B193, and the mesh roll angles of ALFA.
 The generalized coordinate is the cumulative escape-wheel angle phi (= phi_T, radians,
 0 at the start).  The rotor turns by n31*phi, gear 2 by n32*phi.
 
@@ -24,7 +26,8 @@ approach/recess signs s1, s2 of both meshes and the current tooth pair, and by t
 branch of I1R (sign of phi_d times the acceleration, a located event).  The outputs
 J_ref, T_ref are those of the piece in force at the current state.
 
-Mesh position (§2.4, §10.2 item 6): alpha_i = alpha_in + mod(k_i phi + J_i range, range)
+Mesh position (subroutine ALFA and the main program):
+alpha_i = alpha_in + mod(k_i phi + J_i range, range)
 with k2 = r_b3/R_b2 (physical, default) or 32 r_b3/R_b2 (the report's as-run rate),
 k1 = k2 r_b2/R_b1.  Tooth changes and pitch-point crossings are located as events.
 

@@ -1,6 +1,8 @@
 """M739 straight-sided verge escapement: verge (1 DOF psi) and tooth-face contact.
 
-Physics of Lowen & Tepper (1982), note ``models/sa_verge_escapement.md`` §2.2, §3, §4.
+Physics of Lowen & Tepper (1982) (title in ``components.gear_train``): verge and face
+kinematics (App. C-E), verge geometry (App. F), the main program's regime logic and the
+impact map (B205, B210-B212).
 The train enters only through its affine response at the escape-wheel shaft,
 
     J_ref phi_dd = T_ref + c_load T_esc,      T_esc = -A17 Pn   (-AA17 Pn on the exit face)
@@ -31,7 +33,8 @@ Here sigma = +1 on the entrance face and -1 on the exit face.  A contact with cl
 speed v_c = sigma (V_SN - V_TN) > v_capture is an impact (B205, B210-B212, inertia I_STOT
 on the wheel side); after it the tooth stays on the face (e = 0) or separates.
 
-Per-tooth bookkeeping (§3.2): phi_local = phi_T + phi_off; entrance -> exit adds NT Delta to
+Per-tooth bookkeeping (main program, labels 3 and 4): phi_local = phi_T + phi_off;
+entrance -> exit adds NT Delta to
 phi_local, 2 pi - lambda to psi and lambda to psic; exit -> entrance subtracts (NT + 1) Delta,
 2 pi - lambda and lambda.  The output ``psi`` is the verge angle in entrance-face
 coordinates (psi + psic - psic0, wrapped), so it is continuous across re-indexing.
@@ -39,7 +42,8 @@ coordinates (psi + psic - psic0, wrapped), so it is continuous across re-indexin
 The escapement centre distance a = |O_p O_s| is the parameter ``center_distance`` (default the
 M739's 0.226 in): it enters the face kinematics and contact sensing and the fuze-body angles of
 the pallet pivot (``escapement_data``), the parts themselves unchanged, as in the selective
-assembly of the test plans (note models/clock_train_kinematics.md §2.2).  ``J_load`` = I_p U^2
+assembly of the M577/M739 escapement centre-distance test plans (US Army fuze report,
+about 1980, Task 1).  ``J_load`` = I_p U^2
 is the verge inertia riding on the wheel while coupled (0 when free), for a train whose own
 impacts (clock-train tooth handover) must include it.
 """
@@ -617,13 +621,13 @@ class VergeCore:
         return y
 
     def closing_speed(self, y: list[float]) -> tuple[float, float, float]:
-        """(v_c, A1', D1') with v_c = sigma (V_SN - V_TN) (§3.5)."""
+        """(v_c, A1', D1') with v_c = sigma (V_SN - V_TN) (contact test, labels 8-11)."""
         k = self.k
         _, a1p, d1p = face_arms(y[0] + self.phi_off, y[2], self.alpha, k.b, k.c)
         return self.face * (a1p * y[1] - d1p * y[3]), a1p, d1p
 
     def _contact(self, y: list[float], t: float) -> list[float]:
-        """Tip reached the face plane: impact, gentle contact or pass-by (§3.5, §3.6)."""
+        """Tip reached the face plane: impact, gentle contact or pass-by (labels 8-12)."""
         vc, a1p, d1p = self.closing_speed(y)
         if vc < -self.v_capture:
             return y  # separating: stays free (f turns positive again)
