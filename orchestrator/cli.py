@@ -53,6 +53,14 @@ def main(argv: list[str] | None = None) -> int:
     p.set_defaults(handler=_validate)
 
     p = sub.add_parser(
+        "export", help="write a scene as an SSP 1.0 archive (SystemStructure.ssd + its FMUs)"
+    )
+    p.add_argument("scene", type=Path)
+    p.add_argument("out", type=Path, help="the .ssp file to write")
+    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
+    p.set_defaults(handler=_export)
+
+    p = sub.add_parser(
         "crosscheck", help="run a scene in libcosim too and compare with our Jacobi master"
     )
     p.add_argument("scene", type=Path)
@@ -239,6 +247,16 @@ def _validate(args: argparse.Namespace) -> int:
             print(f"  - {problem}")
         failures += bool(problems)
     return 1 if failures else 0
+
+
+def _export(args: argparse.Namespace) -> int:
+    from orchestrator.scenario import load_scene
+    from orchestrator.ssp_export import export_ssp
+
+    scene = load_scene(args.scene, _overrides(args.set))
+    out = export_ssp(scene, args.out)
+    print(f"{out}: {len(scene.fmus)} components, {len(scene.connections)} connections")
+    return 0
 
 
 def _crosscheck(args: argparse.Namespace) -> int:
