@@ -185,10 +185,9 @@ def _run(args: argparse.Namespace) -> int:
 def _run_guarded(args: argparse.Namespace) -> int:
     from orchestrator.cache import check_cache_dir
     from orchestrator.run import run_scene
-    from orchestrator.scenario import load_scene
 
     check_cache_dir()
-    scene = load_scene(args.scene, _overrides(args.set), force=args.force)
+    scene = _load(args.scene, _overrides(args.set), args.force)
     result = run_scene(scene, output_dir=args.output, show_progress=not args.no_progress)
     message = _one_line(RuntimeError(result.message)) if result.message else ""
     if message != result.message.strip():
@@ -212,13 +211,23 @@ def _run_guarded(args: argparse.Namespace) -> int:
     return 0 if result.status == "completed" else 1
 
 
+def _load(path: Path, overrides: dict, force: bool):  # noqa: ANN202 - a Scene
+    """A scene from its TOML file, or a system from an SSP archive (``.ssp``)."""
+    if Path(path).suffix.lower() == ".ssp":
+        from orchestrator.ssp_import import load_ssp
+
+        return load_ssp(path, overrides, force=force)
+    from orchestrator.scenario import load_scene
+
+    return load_scene(path, overrides, force=force)
+
+
 def _check(args: argparse.Namespace) -> int:
     from orchestrator.cache import check_cache_dir
-    from orchestrator.scenario import load_scene
 
     check_cache_dir()
     for path in args.scene:
-        scene = load_scene(path, _overrides(args.set), force=args.force)
+        scene = _load(path, _overrides(args.set), args.force)
         counts = f"{len(scene.fmus)} FMUs, {len(scene.connections)} connections"
         print(f"{path}: ok ({scene.name}, {counts})")
     return 0
