@@ -282,7 +282,7 @@ def _restep(
     return th, y_dense
 
 
-def _first_step(model: EventModel, y: list[float], k1: list[float], control: StepControl) -> float:
+def _first_step(y: list[float], k1: list[float], control: StepControl) -> float:
     """A first step from the sizes of y and y' (HNW 1993, II.4, the simple part)."""
     n = len(y)
     sc = [control.rtol * (control.scales[i] + abs(y[i])) for i in range(n)]
@@ -323,7 +323,7 @@ def advance(
     n_events = steps = rejected = 0
     t_first = t_event = -1.0
     end = h_total * (1.0 - 1e-14)
-    h = h_try if h_try > 0.0 else _first_step(model, y, k1, control)
+    h = h_try if h_try > 0.0 else _first_step(y, k1, control)
     h_next = h
     while t < end:
         left = h_total - t

@@ -352,9 +352,9 @@ class TrainPhysics:
         that grows with its acceleration (Lowen & Tepper 1982, B144 and its I1R term).  The
         report takes it from the last accepted step; here it switches at the located
         instant where velocity times acceleration changes sign (``branch_indicators``), the
-        limit of the report's rule as its step goes to zero."""
-        v = phi_dot if phi_dot != 0.0 else float(self.direction)
-        self.i1r_sign = 1 if v * phi_ddot >= 0.0 else -1
+        limit of the report's rule as its step goes to zero.  The direction of motion stands
+        for the sign of the speed, as in the indicator, so the two never disagree."""
+        self.i1r_sign = 1 if self.direction * phi_ddot >= 0.0 else -1
 
     def branch_indicators(self, phi: float, phi_dot: float, phi_ddot: float) -> tuple[float]:
         """Negative where the I1R branch no longer matches the motion (see update_i1r).

@@ -507,9 +507,8 @@ class VergeCore:
 
     def _switch_branch(self, y: list[float], index: int) -> list[float]:
         d = self.deriv(y)
-        if index == IND_IPR:
-            v = y[3] if y[3] != 0.0 else float(self.s5)
-            self.ipr_sign = 1 if v * d[3] >= 0.0 else -1
+        if index == IND_IPR:  # s5 for the sign of psi_d, as in the indicator
+            self.ipr_sign = 1 if self.s5 * d[3] >= 0.0 else -1
         else:
             self.train.update_i1r(y[1], d[1])
         return y

@@ -233,8 +233,11 @@ def _sweep_throughput(scene_file: str = "lever_rate_vs_load.toml") -> list[tuple
 
 def _same_rows(a: list[dict], b: list[dict]) -> bool:
     """The sweep tables agree in every quantity (wall times aside)."""
-    strip = lambda rows: [{k: v for k, v in r.items() if "wall" not in k} for r in rows]  # noqa: E731
-    return repr(strip(a)) == repr(strip(b))
+
+    def numbers(rows: list[dict]) -> str:
+        return repr([{k: v for k, v in r.items() if "wall" not in k} for r in rows])
+
+    return numbers(a) == numbers(b)
 
 
 def speed() -> None:

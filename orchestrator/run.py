@@ -147,7 +147,7 @@ def _run_locked(
     accuracy: dict[str, float] = {}
     try:
         # No FMU is alive any more: a signal may now stop the analyses where it lands.
-        with guard.raise_at_once():
+        with guard.raise_at_once(), _without_numeric_warnings():
             quantities, accuracy = _analyse(
                 scene, out, recorder, data, status, compare_reference, notes
             )
@@ -202,21 +202,6 @@ def _analyse(
 ) -> tuple[dict[str, dict[str, Any]], dict[str, float]]:
     """Headline, energy residual, scene analysis, plot and error against the reference:
     each that fails adds a note saying why, and the others still count."""
-    with warnings.catch_warnings(), np.errstate(all="ignore"):
-        # non-finite results are reported as such (NaN, or a note): no numpy warnings
-        warnings.simplefilter("ignore", RuntimeWarning)
-        return _analyse_quietly(scene, out, recorder, data, status, compare_reference, notes)
-
-
-def _analyse_quietly(
-    scene: Scene,
-    out: Path,
-    recorder: Recorder,
-    data: np.ndarray,
-    status: str,
-    compare_reference: bool,
-    notes: list[str],
-) -> tuple[dict[str, dict[str, Any]], dict[str, float]]:
     header = recorder.header
     quantities: dict[str, dict[str, Any]] = {}
     with _noted(notes, "headline quantities", header):
@@ -238,6 +223,14 @@ def _analyse_quietly(
             accuracy = compare(header, data, recorder.events, quantities, ref, notes)
             accuracy["reference_wall_time"] = ref.wall_time
     return quantities, accuracy
+
+
+@contextmanager
+def _without_numeric_warnings() -> Iterator[None]:
+    """Non-finite results are reported as such (NaN, or a note), not as numpy warnings."""
+    with warnings.catch_warnings(), np.errstate(all="ignore"):
+        warnings.simplefilter("ignore", RuntimeWarning)
+        yield
 
 
 @contextmanager

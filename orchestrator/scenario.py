@@ -161,10 +161,21 @@ def load_scene(
     ``force`` accepts a run of more than ``MAX_STEPS`` macro steps.
     """
     path = Path(path)
-    raw = read_toml(path)
+    return scene_from_table(path, read_toml(path), overrides, cache_dir, force)
+
+
+def scene_from_table(
+    path: Path,
+    raw: dict[str, Any],
+    overrides: dict[str, Any] | None = None,
+    cache_dir: Path | None = None,
+    force: bool = False,
+) -> Scene:
+    """A scene from its parsed table (as read from a TOML file, or made from another
+    format); ``path`` names the source in messages and anchors relative FMU paths."""
     for dotted, value in (overrides or {}).items():
         _set_dotted(raw, dotted, value)
-    return _Loader(path, raw, cache_dir, force).scene()
+    return _Loader(Path(path), raw, cache_dir, force).scene()
 
 
 def read_toml(path: Path) -> dict[str, Any]:

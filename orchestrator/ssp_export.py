@@ -31,7 +31,7 @@ for _prefix, _uri in (("ssd", SSD), ("ssc", SSC), ("ssv", SSV), ("osp", OSP)):
 #: FMI variable types that an SSD connector names (an Enumeration would need the type's
 #: definition in the SSD too; its connector leaves the type to the FMU, as SSP allows).
 _CONNECTOR_TYPES = ("Real", "Integer", "Boolean", "String")
-_KINDS = {"parameter": "parameter", "input": "input", "output": "output"}
+_KINDS = ("parameter", "input", "output")  # FMI causalities that are SSD connector kinds
 _BASE_UNITS = ("kg", "m", "s", "A", "K", "mol", "cd", "rad")
 
 
@@ -58,10 +58,11 @@ def system_structure(scene: Scene, sources: dict[str, str]) -> ET.Element:
         )
         connectors = ET.SubElement(component, _q(SSD, "Connectors"))
         for var in spec.model.variables.values():
-            kind = _KINDS.get(var.causality)
-            if kind is None:
+            if var.causality not in _KINDS:
                 continue
-            connector = ET.SubElement(connectors, _q(SSD, "Connector"), name=var.name, kind=kind)
+            connector = ET.SubElement(
+                connectors, _q(SSD, "Connector"), name=var.name, kind=var.causality
+            )
             if var.type in _CONNECTOR_TYPES:
                 typed = ET.SubElement(connector, _q(SSC, var.type))
                 if var.type == "Real" and var.unit:

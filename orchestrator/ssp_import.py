@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import Any
 
 from orchestrator.errors import ScenarioError
-from orchestrator.scenario import Scene, _Loader, _set_dotted, read_toml
+from orchestrator.scenario import Scene, read_toml, scene_from_table
 from orchestrator.ssp_export import OSP, SSC, SSD, SSV
 
 #: Tables a companion TOML may give (the system itself comes from the archive).
@@ -42,9 +42,7 @@ def load_ssp(
         for table in COMPANION_TABLES:
             if isinstance(extra.get(table), dict):
                 raw.setdefault(table, {}).update(extra[table])
-    for dotted, value in (overrides or {}).items():
-        _set_dotted(raw, dotted, value)
-    return _Loader(path, raw, cache_dir, force).scene()
+    return scene_from_table(path, raw, overrides, cache_dir, force)
 
 
 def _unpack(path: Path) -> tuple[ET.Element, Path]:
