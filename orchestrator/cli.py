@@ -271,9 +271,9 @@ def _export(args: argparse.Namespace) -> int:
 def _crosscheck(args: argparse.Namespace) -> int:
     import numpy as np
 
-    from orchestrator.crosscheck import run_with_libcosim
     from orchestrator.run import run_scene
     from orchestrator.scenario import load_scene
+    from orchestrator.studies.crosscheck import run_with_libcosim
 
     scene = load_scene(args.scene, {"master.algorithm": "jacobi"})
     ours = run_scene(scene, show_progress=False)
@@ -289,7 +289,7 @@ def _crosscheck(args: argparse.Namespace) -> int:
 
 
 def _precision(args: argparse.Namespace) -> int:
-    from orchestrator.work_precision import (
+    from orchestrator.studies.work_precision import (
         STEP_FACTORS,
         TOLERANCES,
         observed_order,
@@ -313,7 +313,7 @@ def _precision(args: argparse.Namespace) -> int:
 
 
 def _sweep(args: argparse.Namespace) -> int:
-    from orchestrator.parameter_sweep import run_sweep
+    from orchestrator.studies.parameter_sweep import run_sweep
 
     result = run_sweep(
         args.scene, args.output, args.workers, args.dask, _overrides(args.set) or None
@@ -324,7 +324,7 @@ def _sweep(args: argparse.Namespace) -> int:
 
 
 def _stability(args: argparse.Namespace) -> int:
-    from orchestrator.stability import run_suite
+    from orchestrator.studies.stability import run_suite
 
     rows = run_suite(out_dir=args.output, workers=args.workers, dask_address=args.dask)
     print((args.output / "stability.md").read_text())
@@ -333,7 +333,7 @@ def _stability(args: argparse.Namespace) -> int:
 
 
 def _bench(args: argparse.Namespace) -> int:
-    from orchestrator.benchmarks import BENCHMARKS
+    from orchestrator.studies.benchmarks import BENCHMARKS
 
     BENCHMARKS[args.name]()
     return 0

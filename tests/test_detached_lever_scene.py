@@ -222,7 +222,7 @@ def test_rate_against_load_unit1(tmp_path, fmu_cache) -> None:
 
 @pytest.mark.slow
 def test_full_rate_sweep(tmp_path) -> None:
-    from orchestrator.parameter_sweep import run_sweep
+    from orchestrator.studies.parameter_sweep import run_sweep
 
     result = run_sweep(RATE, workers=2, output_dir=tmp_path)
     assert len(result.rows) == 30 and all(r["status"] == "completed" for r in result.rows)

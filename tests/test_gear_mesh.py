@@ -360,7 +360,7 @@ def test_scene_with_a_bad_mesh_number() -> None:
 def test_sweep_over_mu_and_the_nine_meshes(tmp_path: Path) -> None:
     """The [sweep] of mesh_efficiency.toml: each run's cycle and minimum efficiency against the
     closed form, and the physical-ALFIN minima against the note's §9 K-point recomputation."""
-    from orchestrator.parameter_sweep import run_sweep
+    from orchestrator.studies.parameter_sweep import run_sweep
 
     res = run_sweep(SCENARIOS / "mesh_efficiency.toml", workers=2, output_dir=tmp_path)
     section_9 = {1: (.9680, .9091), 2: (.8666, .6594), 3: (.8801, .6913), 5: (.9166, .7729),

@@ -8,8 +8,8 @@ from pathlib import Path
 import pytest
 
 from orchestrator.errors import ScenarioError
-from orchestrator.parameter_sweep import run_sweep
 from orchestrator.scenario import load_scene
+from orchestrator.studies.parameter_sweep import run_sweep
 
 SCENE = (Path(__file__).resolve().parent.parent / "scenarios" / "two_inertias.toml").read_text()
 SWEEP = """

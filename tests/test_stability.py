@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from orchestrator.stability import case_files, run_suite
+from orchestrator.studies.stability import case_files, run_suite
 
 EXPECTED_STABLE = {
     "m739_friction_zero",

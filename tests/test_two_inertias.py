@@ -114,7 +114,7 @@ def test_failed_run_keeps_what_it_recorded(tmp_path, fmu_cache) -> None:
 
 def test_agrees_with_libcosim_at_the_same_step(tmp_path, fmu_cache) -> None:
     pytest.importorskip("libcosimpy")
-    from orchestrator.crosscheck import run_with_libcosim
+    from orchestrator.studies.crosscheck import run_with_libcosim
 
     scene = load_scene(SCENE, {"master.algorithm": "jacobi", "scene.stop": "0.2 s"})
     ours = run_scene(scene, output_dir=tmp_path / "ours", cache_dir=fmu_cache, show_progress=False)

@@ -7,8 +7,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from orchestrator.sweep import Job, run_jobs
-from orchestrator.work_precision import START_HOLD, observed_order, work_precision
+from orchestrator.studies.jobs import Job, run_jobs
+from orchestrator.studies.work_precision import START_HOLD, observed_order, work_precision
 
 SCENE = Path(__file__).resolve().parent.parent / "scenarios" / "two_inertias.toml"
 

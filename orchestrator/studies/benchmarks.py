@@ -195,7 +195,7 @@ def _sweep_throughput(scene_file: str = "lever_rate_vs_load.toml") -> list[tuple
     """Throughput of a parameter sweep on 2 workers against 1: process pool and Dask."""
     from dask.distributed import LocalCluster
 
-    from orchestrator.parameter_sweep import run_sweep
+    from orchestrator.studies.parameter_sweep import run_sweep
 
     out = Path("runs") / "bench_speed_sweep"
     walls: dict[tuple[str, int], float] = {}

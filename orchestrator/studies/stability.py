@@ -21,11 +21,11 @@ import numpy as np
 from orchestrator.accuracy import compare
 from orchestrator.run import reference_of
 from orchestrator.scenario import load_scene
-from orchestrator.sweep import Job, JobResult, run_jobs
+from orchestrator.studies.jobs import Job, JobResult, run_jobs
 
 SUITE_DIR = Path(__file__).resolve().parent.parent / "scenarios" / "stability"
 ENERGY_LIMIT = 0.05  # relative energy residual above which a run is called unstable
-MASTERS = ("regime-aware", "jacobi", "gauss-seidel")
+STABILITY_MASTERS = ("regime-aware", "jacobi", "gauss-seidel")
 
 
 @dataclass
@@ -52,7 +52,7 @@ def run_suite(
     out_dir: Path = Path("runs") / "stability",
     workers: int | None = None,
     dask_address: str | None = None,
-    masters: tuple[str, ...] = MASTERS,
+    masters: tuple[str, ...] = STABILITY_MASTERS,
     cases: tuple[str, ...] | None = None,
 ) -> list[CaseRow]:
     """Run every case (or those named in ``cases``) under each master; write the table."""

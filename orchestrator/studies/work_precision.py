@@ -21,7 +21,7 @@ from orchestrator.errors import ScenarioError
 from orchestrator.masters import TOLERANCE_MASTERS
 from orchestrator.run import reference_of
 from orchestrator.scenario import Scene, load_scene
-from orchestrator.sweep import Job, JobResult, run_jobs
+from orchestrator.studies.jobs import Job, JobResult, run_jobs
 
 STEP_FACTORS = (8.0, 4.0, 2.0, 1.0, 0.5, 0.25)
 TOLERANCES = (1e-2, 3e-3, 1e-3, 3e-4, 1e-4)

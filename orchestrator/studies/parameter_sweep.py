@@ -2,7 +2,7 @@
 
 A scene's ``[sweep]`` table names the dotted key to vary, its values and, optionally, series
 (sets of overrides, one line each in the plot: Table I units, meshes, ...).  The runs go to
-the same process pool or Dask cluster as every other sweep (``orchestrator.sweep``); the
+the same process pool or Dask cluster as every other sweep (``orchestrator.studies.jobs``); the
 results are ``sweep.csv`` (one row per run), ``sweep.png`` (each quantity against the swept
 value, a line per series) and ``sweep.md``, under ``runs/<scene>/sweep`` by default.
 """
@@ -18,7 +18,7 @@ from typing import Any
 
 from orchestrator.errors import ScenarioError
 from orchestrator.scenario import Scene, SweepSeries, load_scene
-from orchestrator.sweep import Job, JobResult, run_jobs
+from orchestrator.studies.jobs import Job, JobResult, run_jobs
 
 _BASE = SweepSeries("", {})
 

@@ -1,0 +1,6 @@
+"""Studies: many runs of a scene and what they say together.
+
+`jobs` runs scenes in parallel (process pool or Dask); `parameter_sweep`,
+`work_precision`, `stability`, `benchmarks` and `crosscheck` are built on it or
+on single runs.
+"""
