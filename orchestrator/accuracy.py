@@ -7,7 +7,7 @@ from typing import Any
 
 import numpy as np
 
-from orchestrator.references import Reference
+from orchestrator.scenes.family import Reference
 
 
 def compare(

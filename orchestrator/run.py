@@ -23,15 +23,16 @@ from tqdm import tqdm
 
 from fmus.build import build_fmu
 from orchestrator.accuracy import compare
-from orchestrator.analyses import ANALYSES, PLOTS, energy_residual, headline, missing_column
+from orchestrator.analyses import energy_residual, headline, missing_column
 from orchestrator.errors import RunError
 from orchestrator.fmu_instance import file_sha256
 from orchestrator.interrupt import Interrupted, SignalGuard, catching_signals, signal_name
 from orchestrator.masters import MASTERS
 from orchestrator.output_lock import OutputLock
 from orchestrator.recorder import Recorder, StepStats
-from orchestrator.references import REFERENCES, Reference
 from orchestrator.scenario import Scene
+from orchestrator.scenes import ANALYSES, PLOTS, REFERENCES
+from orchestrator.scenes.family import Reference
 from orchestrator.system import CoupledSystem
 
 PROJECT_DIR = Path(__file__).resolve().parent.parent

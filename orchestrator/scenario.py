@@ -19,6 +19,8 @@ from fmus.build import BuildError, build_fmu
 from fmus.registry import FMU_WRAPPERS
 from orchestrator.errors import ScenarioError
 from orchestrator.model_info import ModelInfo, ModelInfoError, VariableInfo, model_info
+from orchestrator.scenes import ANALYSES, REFERENCES, family
+from orchestrator.scenes.family import Option
 from orchestrator.units import to_si
 
 ALGORITHMS = ("jacobi", "gauss-seidel", "regime-aware")
@@ -654,8 +656,6 @@ class _Loader:
             headline[hname] = HeadlineSpec(signal, reduce, unit)
         analysis = node.get("analysis")
         if analysis is not None:
-            from orchestrator.analyses import ANALYSES
-
             if not isinstance(analysis, str) or analysis not in ANALYSES:
                 raise self.fail(
                     "report.analysis", f"unknown {analysis!r}; expected one of {sorted(ANALYSES)}"
@@ -663,8 +663,6 @@ class _Loader:
         options = self.table(node.get("options", {}), "report.options")
         reference = node.get("reference")
         if reference is not None:
-            from orchestrator.references import REFERENCES
-
             if not isinstance(reference, str) or reference not in REFERENCES:
                 known = sorted(REFERENCES)
                 raise self.fail(
@@ -685,8 +683,6 @@ class _Loader:
         record: tuple[tuple[str, str], ...],
     ) -> None:
         """What the report reads is recorded, and its options are ones it knows."""
-        from orchestrator.analyses import NEEDS, Needs
-
         recorded = {f"{i}.{v}" for i, v in record}
         for hname, spec in headline.items():
             if ".".join(spec.signal) not in recorded:
@@ -695,8 +691,8 @@ class _Loader:
                     f"{'.'.join(spec.signal)} is not recorded; add it to output.record",
                 )
         users = [n for n in dict.fromkeys((analysis, reference)) if n is not None]
-        needs = [NEEDS.get(n, Needs()) for n in users]
-        known = sorted({o for need in needs for o in need.options})
+        needs = [family(n).needs for n in users]
+        known = sorted({o.name for need in needs for o in need.options})
         for key in options:
             if key not in known:
                 if not users:
@@ -708,18 +704,13 @@ class _Loader:
                     f"report.options.{key}",
                     f"unknown key for {' and '.join(map(repr, users))}; expected one of {known}",
                 )
+        for need in needs:
+            for option in need.options:
+                if option.name in options:
+                    self.report_option(option, options[option.name], fmus)
         if analysis is None:
             return
-        need = NEEDS.get(analysis, Needs())
-        for role in need.roles:
-            if role.option and role.option in options:
-                value = options[role.option]
-                if not isinstance(value, str) or value not in fmus:
-                    raise self.fail(
-                        f"report.options.{role.option}",
-                        f"expected an FMU instance of the scene, one of {sorted(fmus)}; "
-                        f"got {value!r}",
-                    )
+        need = family(analysis).needs
         missing = need.missing_signals(fmus, options, recorded)
         if missing:
             raise self.fail(
@@ -727,6 +718,27 @@ class _Loader:
                 f"analysis {analysis!r} needs {', '.join(missing)} recorded; add "
                 f"{'it' if len(missing) == 1 else 'them'} to output.record",
             )
+
+    def report_option(self, option: Option, value: Any, fmus: dict[str, FmuSpec]) -> None:
+        """One [report.options] value against the kind its family declares."""
+        key = f"report.options.{option.name}"
+        if option.kind == "instance":
+            if not isinstance(value, str) or value not in fmus:
+                raise self.fail(
+                    key,
+                    f"expected an FMU instance of the scene, one of {sorted(fmus)}; got {value!r}",
+                )
+        elif option.kind == "count":
+            if isinstance(value, bool) or not isinstance(value, int) or value < 0:
+                raise self.fail(key, f"expected a whole number >= 0, got {value!r}")
+        elif option.kind == "flag":
+            if not isinstance(value, bool):
+                raise self.fail(key, f"expected true or false, got {value!r}")
+        elif option.kind == "quantity":
+            if not self.quantity(value, key, option.unit) > 0.0:
+                raise self.fail(
+                    key, f"expected a positive quantity in {option.unit}, got {value!r}"
+                )
 
     def sweep(self, node: Any, fmus: dict[str, FmuSpec]) -> SweepSpec:
         node = self.table(node, "sweep")

@@ -7,7 +7,7 @@ import math
 import numpy as np
 
 from orchestrator.accuracy import compare, observable
-from orchestrator.references import Reference
+from orchestrator.scenes.family import Reference
 
 
 def test_a_regime_entered_and_left_at_one_instant_is_not_an_observable_switch() -> None:

@@ -23,10 +23,14 @@ from components.m739_data import M739
 from components.mesh_efficiency import contact_efficiency
 from components.verge_escapement import VergeEscapement, escapement_data
 from components.verge_geometry import kinem
-from orchestrator.references.m739 import run_m739
 from orchestrator.run import run_scene
 from orchestrator.scenario import load_scene
-from orchestrator.scenes.clock_train import ARMING_ROTOR_ANGLE, arming_phi, run_clock_train
+from orchestrator.scenes.clock_train.monolithic import (
+    ARMING_ROTOR_ANGLE,
+    arming_phi,
+    run_clock_train,
+)
+from orchestrator.scenes.m739.monolithic import run_m739
 
 SCENARIOS = Path(__file__).resolve().parent.parent / "scenarios"
 SCENE = SCENARIOS / "clock_train_sa.toml"

@@ -15,7 +15,7 @@ from components.detached_lever_data import TABLE_I
 from orchestrator.errors import ScenarioError
 from orchestrator.run import RunResult, run_scene
 from orchestrator.scenario import load_scene
-from orchestrator.scenes.detached_lever import lever_scene
+from orchestrator.scenes.detached_lever.lever import lever_scene
 
 SCENARIOS = Path(__file__).resolve().parent.parent / "scenarios"
 DECAY = SCENARIOS / "lever_unit_decay.toml"

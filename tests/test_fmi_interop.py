@@ -22,9 +22,9 @@ from fmus.build import build_fmu
 from orchestrator.errors import RunError, ScenarioError
 from orchestrator.fmu_instance import FmuInstance
 from orchestrator.model_info import model_info
-from orchestrator.references.two_inertias import two_inertias_exact
 from orchestrator.run import run_scene
 from orchestrator.scenario import load_scene
+from orchestrator.scenes.two_inertias.report import two_inertias_exact
 
 needs_cc = pytest.mark.skipif(foreign_fmus.c_compiler() is None, reason="no C compiler")
 

@@ -47,7 +47,7 @@ from components.mesh_efficiency_data import (
 from orchestrator.errors import ScenarioError
 from orchestrator.run import run_scene
 from orchestrator.scenario import load_scene
-from orchestrator.scenes.gear_mesh import mesh_scene
+from orchestrator.scenes.gear_mesh.report import mesh_scene
 
 SCENARIOS = Path(__file__).resolve().parent.parent / "scenarios"
 Z = LEGACY_PI / 180.0  # the programs' degree factor

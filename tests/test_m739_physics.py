@@ -37,7 +37,7 @@ from components.verge_geometry import (
     kinem,
     normal_velocities,
 )
-from orchestrator.references.m739 import REFERENCE_TOLERANCE, run_m739
+from orchestrator.scenes.m739.monolithic import REFERENCE_TOLERANCE, run_m739
 
 
 def rel(a: float, b: float) -> float:

@@ -60,7 +60,7 @@ from components.sprag_clutch import (
     tangent_stiffness,
     two_point_hertz,
 )
-from orchestrator.references.press_feed import (
+from orchestrator.scenes.press_feed.monolithic import (
     FEED,
     OVERRUN,
     UNWIND,

@@ -24,7 +24,7 @@ import pytest
 
 from orchestrator.run import RunResult, reference_of, run_scene
 from orchestrator.scenario import load_scene
-from orchestrator.scenes.press_feed import (
+from orchestrator.scenes.press_feed.report import (
     FEED,
     OVERRUN,
     UNWIND,

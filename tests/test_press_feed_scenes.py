@@ -4,7 +4,7 @@ Runs 1-3 of Xu (1993) Part I and the Part II sprag-clutch decay experiment at 72
 197 rpm, each a scene in scenarios/.  Here every scene runs with fixed-step Gauss-Seidel,
 clutch first, at 0.1 ms (0.05 ms for the decay scenes) — Run 2's own default is the
 regime-aware master, tested in test_press_feed_regime_aware.py.  The errors are measured
-against ``orchestrator.scenes.press_feed:reference`` (same parameters, exact events).
+against ``orchestrator.scenes.press_feed.report:reference`` (same parameters, exact events).
 
 Stated tolerances at each scene's default step (measured values in brackets, worst scene):
 feed length per cycle 1e-3 relative [7.3e-4, Run 2], windup history 3e-2 of the peak
@@ -24,7 +24,7 @@ from components.press_feed_data import ROLLER_RADIUS
 from orchestrator.cli import main as cli_main
 from orchestrator.run import RunResult, reference_of, run_scene
 from orchestrator.scenario import load_scene
-from orchestrator.scenes.press_feed import (
+from orchestrator.scenes.press_feed.report import (
     FEED,
     OVERRUN,
     UNWIND,

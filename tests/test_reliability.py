@@ -21,9 +21,9 @@ from orchestrator.cli import main
 from orchestrator.errors import RunError, ScenarioError
 from orchestrator.output_lock import LOCK_NAME, OutputInUseError, OutputLock
 from orchestrator.recorder import Recorder
-from orchestrator.references import Reference
 from orchestrator.run import run_scene
 from orchestrator.scenario import load_scene
+from orchestrator.scenes.family import Reference
 from orchestrator.system import CoupledSystem
 
 PROJECT_DIR = Path(__file__).resolve().parent.parent
@@ -31,6 +31,7 @@ SCENARIOS = PROJECT_DIR / "scenarios"
 TWO = SCENARIOS / "two_inertias.toml"
 M739 = SCENARIOS / "m739.toml"
 PRESS = SCENARIOS / "press_feed_run1.toml"
+LEVER = SCENARIOS / "lever_unit_decay.toml"
 SHORT = {"scene.stop": "10 ms"}
 
 
@@ -156,7 +157,7 @@ def test_m739_without_spin_has_no_reference_trajectory_but_ends(tmp_path: Path) 
 def test_an_analysis_that_fails_leaves_a_note(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, column: str | None, expected: str
 ) -> None:
-    import orchestrator.scenes.press_feed as pf
+    import orchestrator.scenes.press_feed.report as pf
 
     def broken(scene, header, data, options):
         col = {name: data[:, i] for i, name in enumerate(header)}
@@ -180,6 +181,23 @@ def test_missing_record_signal_and_bogus_option_caught_at_load() -> None:
         load_scene(M739, {"report.options.train": "nobody"})
     with pytest.raises(ScenarioError, match=r"\[report.headline.x.signal\].*not recorded"):
         load_scene(TWO, {"report.headline.x": {"signal": "a.tau"}})
+
+
+@pytest.mark.parametrize(
+    ("scene", "key", "value", "fragment"),
+    [
+        (LEVER, "nominal_period", "-1 s", "positive quantity in s"),
+        (LEVER, "load_step", "2 m", "N.m"),
+        (LEVER, "lever", "nobody", "FMU instance"),
+        (PRESS, "startup_cycles", 1.5, "whole number"),
+        (PRESS, "decay_ratios", "yes", "true or false"),
+    ],
+)
+def test_option_values_checked_at_load(scene: Path, key: str, value, fragment: str) -> None:
+    """Each family declares the kind of its options; a wrong value never reaches a run."""
+    with pytest.raises(ScenarioError, match=rf"\[report.options.{key}\]") as info:
+        load_scene(scene, {f"report.options.{key}": value})
+    assert fragment in str(info.value)
 
 
 # -- 5. nonsense refused at load -------------------------------------------------------------

@@ -11,9 +11,9 @@ import numpy as np
 import pytest
 
 from components.rotational import Inertia, SpringDamperInertia
-from orchestrator.references.two_inertias import two_inertias_exact
 from orchestrator.run import run_scene
 from orchestrator.scenario import load_scene
+from orchestrator.scenes.two_inertias.report import two_inertias_exact
 
 SCENE = Path(__file__).resolve().parent.parent / "scenarios" / "two_inertias.toml"
 

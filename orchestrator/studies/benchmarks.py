@@ -17,7 +17,7 @@ from orchestrator.fmu_instance import FmuInstance
 from orchestrator.run import run_scene
 from orchestrator.scenario import load_scene
 
-SCENARIOS = Path(__file__).resolve().parent.parent / "scenarios"
+SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
 
 
 def _best_per_call(fn: Callable[[int], None], n: int, repeats: int = 5) -> float:
@@ -107,7 +107,7 @@ def m739(budget: float = 300.0) -> None:
     halved from 1 us until its error reaches the regime-aware master's or ``budget``
     seconds of Jacobi runs are spent (then the time is extrapolated at the observed order).
     """
-    from orchestrator.references.m739 import run_m739
+    from orchestrator.scenes.m739.monolithic import run_m739
 
     out = Path("runs") / "bench_m739"
     t0 = time.perf_counter()
@@ -246,8 +246,8 @@ def speed() -> None:
     Truths: the monolithic models at tolerance 1e-12.  The monolithic time is that of the
     loosest tolerance whose turns error is within the same budget as the co-simulation's.
     """
-    from orchestrator.references.m739 import run_m739
-    from orchestrator.scenes.clock_train import run_clock_train
+    from orchestrator.scenes.clock_train.monolithic import run_clock_train
+    from orchestrator.scenes.m739.monolithic import run_m739
 
     rows: list[tuple[str, float, str]] = []
     for name, run, scene_file in (

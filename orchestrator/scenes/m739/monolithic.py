@@ -2,7 +2,7 @@
 
 The verge regime machine (``components.verge_escapement.VergeCore``) runs with the *live*
 train physics (``components.gear_train.TrainPhysics``) instead of a held affine response,
-so train and verge form one ODE system, integrated by the same RK4 stepper with exact
+so train and verge form one ODE system, integrated by the same event-locating integrator with exact
 location of every event (regime changes, impacts, mesh tooth changes and pitch points,
 friction reversals, arming angle).  No equation is repeated here.
 
@@ -25,7 +25,7 @@ import numpy as np
 
 from components.event_integration import StepControl, advance
 from components.gear_train import INDEXING_AS_RUN, INDEXING_PHYSICAL, TrainPhysics
-from components.m739_data import M739, M739Data, rpm_to_rad_s
+from components.m739_data import LBF, M739, M739Data, rpm_to_rad_s
 from components.verge_escapement import REGIME_NAMES, STATE_SCALES, VergeConstants, VergeCore
 
 #: Relative local error tolerance of the monolithic integration: turns to arm move by less
@@ -57,8 +57,6 @@ class M739Result:
 
     def summary(self) -> str:
         """One line, forces in lb (the report's unit)."""
-        from components.m739_data import LBF
-
         head = f"armed in {self.turns:.3f} turns" if self.armed else f"did not arm: {self.reason}"
         return (
             f"{head}; F23 {self.f23_max / LBF:.3f} F12 {self.f12_max / LBF:.3f} "
@@ -67,7 +65,7 @@ class M739Result:
         )
 
 
-class _Monolithic(VergeCore):
+class VergeTrainMonolithic(VergeCore):
     """VergeCore with live train physics, recording maxima and the time series."""
 
     def __init__(self, *args: object, **kwargs: object) -> None:
@@ -141,12 +139,12 @@ def run_m739(
     code = _indexing_code(indexing)
     train = TrainPhysics(data, mu=mu, omega=omega, indexing=code)
     k = VergeConstants(data, mu1, mu, omega, e_rest)
-    core = _Monolithic(k, train, data.phi_start, phi_stop=data.phi_cut, log=log)
+    core = VergeTrainMonolithic(k, train, data.phi_start, phi_stop=data.phi_cut, log=log)
     return simulate(core, data, events, t_stop, tolerance, sample_dt)
 
 
 def simulate(
-    core: _Monolithic,
+    core: VergeTrainMonolithic,
     data: M739Data,
     events: list[tuple[float, int, int, str]],
     t_stop: float,
@@ -225,7 +223,7 @@ def simulate(
 
 
 def _finish(
-    core: _Monolithic,
+    core: VergeTrainMonolithic,
     y: list[float],
     t: float,
     armed: bool,

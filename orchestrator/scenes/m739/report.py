@@ -15,9 +15,10 @@ from typing import Any
 import numpy as np
 
 from components.m739_data import LBF, M739
-from components.verge_escapement import FREE, REGIME_NAMES
-from orchestrator.references import Reference
+from components.verge_escapement import FREE, REGIME_NAMES, escapement_data
 from orchestrator.scenario import Scene
+from orchestrator.scenes.family import Reference
+from orchestrator.scenes.m739.monolithic import run_m739
 
 RPM_PER_RAD_S = 60.0 / (2.0 * math.pi)
 
@@ -87,9 +88,6 @@ def _why_not_armed(scene: Scene, col: dict[str, np.ndarray], train: str) -> str:
 
 def reference(scene: Scene) -> Reference:
     """The monolithic M739 model with the scene's physics, as the yardstick."""
-    from components.verge_escapement import escapement_data
-    from orchestrator.references.m739 import run_m739
-
     train, verge = _names(scene)
     spin = _parameter(scene, train, "spin")
     data = escapement_data(

@@ -8,7 +8,7 @@ discrete states: 1 windup (engaged, shaft stuck, rocker forward), 2 feed (shaft 
 
 Cycles are crank revolutions counted from the scene start, where the rocker is at its
 extreme (start of Regime 1); the first one is the start-up cycle.  The reference
-(``orchestrator.references.press_feed``) is reduced with the same definitions, so its
+(``orchestrator.scenes.press_feed.monolithic``) is reduced with the same definitions, so its
 headline values carry the same names as those of ``analyse``.
 """
 
@@ -37,9 +37,13 @@ from components.rssr_coupler import REGIME_NAMES as DRIVE_NAMES
 from components.rssr_kinematics import ExactRSSR, rocker_extremes
 from components.sprag_clutch import MODEL_HERTZ, MODEL_LUMPED, REGIME_ENGAGED, SpragClutch
 from components.sprag_clutch import REGIME_NAMES as CLUTCH_NAMES
-from orchestrator.references import Reference
-from orchestrator.references.press_feed import peak_to_trough_ratios
 from orchestrator.scenario import Scene
+from orchestrator.scenes.family import Reference
+from orchestrator.scenes.press_feed.monolithic import (
+    FeedOptions,
+    peak_to_trough_ratios,
+    simulate_feed,
+)
 
 WINDUP, FEED, UNWIND, OVERRUN = 1, 2, 3, 4
 REGIME_LABELS = {WINDUP: "windup", FEED: "feed", UNWIND: "unwind", OVERRUN: "overrun"}
@@ -382,8 +386,6 @@ def _same(a: float, b: float) -> bool:
 
 def feed_options(scene: Scene):
     """FeedOptions of the monolithic reference for a scene; ValueError if it cannot match."""
-    from orchestrator.references.press_feed import FeedOptions
-
     fs = feed_scene(scene)
     pd, pc, pl = fs.p_drive, fs.p_clutch, fs.p_load
     defaults = {v.name: float(v.start) for v in CrankCouplerDrive.variables("parameter")}
@@ -521,8 +523,6 @@ def _feeding_mask(times: np.ndarray, trans: list[tuple[float, int]]) -> np.ndarr
 
 def reference(scene: Scene) -> Reference:
     """Monolithic reference of a press-feed scene: same parameters, exact events."""
-    from orchestrator.references.press_feed import simulate_feed
-
     fs = feed_scene(scene)
     opts = feed_options(scene)
     res = simulate_feed(opts)

@@ -53,8 +53,8 @@ from components.mesh_efficiency import (
     train_mesh_cycle_summary,
 )
 from orchestrator.errors import ScenarioError
-from orchestrator.references import Reference
 from orchestrator.scenario import Scene
+from orchestrator.scenes.family import Reference
 
 #: Names of the efficiency on the (left, right) side of each kind of contact change.
 _SIDES = {

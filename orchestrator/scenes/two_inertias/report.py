@@ -9,7 +9,8 @@ from __future__ import annotations
 import numpy as np
 
 from components.rotational import damped_oscillator_transition
-from orchestrator.references import Reference
+from orchestrator.scenario import Scene
+from orchestrator.scenes.family import Reference
 
 
 def two_inertias_exact(
@@ -45,7 +46,7 @@ def two_inertias_exact(
     }
 
 
-def two_inertias_reference(scene) -> Reference:  # noqa: ANN001 (Scene; avoids an import cycle)
+def two_inertias_reference(scene: Scene) -> Reference:
     """The closed form as the scene's Reference (instances named in report.options)."""
     a = scene.analysis_options.get("body_a", "a")
     b = scene.analysis_options.get("body_b", "b")

@@ -1,0 +1,23 @@
+"""The detached-lever escapement: beat amplitude, period and rate against drive torque."""
+
+from orchestrator.scenes.family import Needs, Option, Role, SceneFamily
+
+FAMILY = SceneFamily(
+    needs=Needs(
+        options=(
+            Option("lever"),
+            Option("nominal_period", "quantity", "s"),
+            Option("load_step", "quantity", "N.m"),
+        ),
+        roles=(
+            Role(
+                "DetachedLever",
+                option="lever",
+                signals=("theta", "amplitude", "beat_count", "period", "regime"),
+            ),
+        ),
+    ),
+    analysis="orchestrator.scenes.detached_lever.report:analyse",
+    plot="orchestrator.scenes.detached_lever.report:plot",
+    reference="orchestrator.scenes.detached_lever.report:reference",
+)

@@ -1,0 +1,94 @@
+"""What a scene family declares: the reference it measures runs against, and what its
+analysis and reference read from a scene (options and recorded signals).
+
+This module is a leaf: the scene loader imports it to check a scene's [report] at load,
+without importing any family's analysis or models.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+
+@dataclass
+class Reference:
+    """What a reference knows: headline values, signals at any time, located events."""
+
+    headline: dict[str, float]
+    signals: Callable[[np.ndarray], dict[str, np.ndarray]]  # "inst.var" -> values at times
+    events: list[tuple[float, str, str, str]] = field(default_factory=list)
+    wall_time: float = 0.0
+    #: times the signals are known for (None: any time); outside, they are not compared
+    t_range: tuple[float, float] | None = None
+
+
+@dataclass(frozen=True)
+class Option:
+    """A [report.options] key a family reads, and what its value must be: ``instance`` (an FMU
+    instance of the scene), ``count`` (a whole number >= 0), ``flag`` (true/false) or
+    ``quantity`` (a positive value in ``unit``)."""
+
+    name: str
+    kind: str = "instance"
+    unit: str = ""
+
+
+@dataclass(frozen=True)
+class Role:
+    """An FMU instance an analysis works on: named by ``option`` in [report.options], else
+    the instance called ``default``, else the scene's only instance of ``component``."""
+
+    component: str
+    default: str | None = None
+    option: str | None = None
+    signals: tuple[str, ...] = ()  # variables the analysis reads (they must be recorded)
+
+
+@dataclass(frozen=True)
+class Needs:
+    """What an analysis (and the reference of the same name) reads: its [report.options]
+    keys and the recorded signals, checked when the scene is loaded."""
+
+    options: tuple[Option, ...] = ()
+    roles: tuple[Role, ...] = field(default_factory=tuple)
+
+    def instance(self, role: Role, scene_fmus: dict[str, Any], options: dict[str, Any]):
+        """The instance playing ``role`` (None when the scene does not say which)."""
+        if role.option and role.option in options:
+            name = options[role.option]
+            return name if isinstance(name, str) and name in scene_fmus else None
+        if role.default and role.default in scene_fmus:
+            return role.default
+        found = [n for n, spec in scene_fmus.items() if spec.component == role.component]
+        return found[0] if len(found) == 1 else None
+
+    def missing_signals(
+        self, scene_fmus: dict[str, Any], options: dict[str, Any], recorded: set[str]
+    ) -> list[str]:
+        out = []
+        for role in self.roles:
+            name = self.instance(role, scene_fmus, options)
+            if name is None:
+                continue
+            out.extend(f"{name}.{v}" for v in role.signals if f"{name}.{v}" not in recorded)
+        return out
+
+
+@dataclass(frozen=True)
+class SceneFamily:
+    """One family of scenes (``[report] analysis`` / ``reference`` name it): what it reads,
+    and where its analysis, plot and reference live ("module:function", imported when used).
+
+    analysis: (scene, header, data, options) -> {name: {"value", "unit"}}
+    plot: (scene, header, data, path) -> None, writing a PNG at path
+    reference: (scene) -> Reference, the monolithic yardstick of the coupling error
+    """
+
+    needs: Needs = field(default_factory=Needs)
+    analysis: str | None = None
+    plot: str | None = None
+    reference: str | None = None

@@ -1,0 +1,24 @@
+"""One involute or clock gear mesh: point and cycle efficiency against the closed form."""
+
+from orchestrator.scenes.family import Needs, Role, SceneFamily
+
+FAMILY = SceneFamily(
+    needs=Needs(
+        roles=(
+            Role(
+                "GearMesh",
+                signals=(
+                    "driver_angle",
+                    "efficiency",
+                    "regime",
+                    "input_work",
+                    "output_work",
+                    "dissipated_work",
+                ),  # fmt: skip
+            ),
+        )
+    ),
+    analysis="orchestrator.scenes.gear_mesh.report:analyse",
+    plot="orchestrator.scenes.gear_mesh.report:plot",
+    reference="orchestrator.scenes.gear_mesh.report:reference",
+)

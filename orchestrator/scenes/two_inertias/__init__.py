@@ -1,0 +1,8 @@
+"""Two inertias on a spring-damper: the plumbing scene with a closed-form solution."""
+
+from orchestrator.scenes.family import Needs, SceneFamily
+
+FAMILY = SceneFamily(
+    needs=Needs(),
+    reference="orchestrator.scenes.two_inertias.report:two_inertias_reference",
+)
