@@ -2,11 +2,12 @@
 
 The rotor, inertias, eccentricity and spin of the M739 S&A (Lowen & Tepper 1982, note
 ``models/sa_verge_escapement.md`` §1, data ``components.m739_data``) drive the escape wheel
-through the two clock meshes of ``components.clock_train.M739_TRAIN`` (note
+through the two clock meshes of ``components.clock_train_kinematics.M739_TRAIN`` (note
 ``models/clock_train_kinematics.md``) instead of the M739's involute train.
 
 Representative geometry (neither source gives a clock tooth form for the M739; the choice is
-the one documented in ``components.clock_train``): the M739 tooth counts and centre distances,
+the one documented in ``components.clock_train_kinematics``): the M739 tooth counts and centre
+distances,
 rotor gear 64 teeth on 0.4701 in to pinion 2 of 9 leaves, gear 2 of 36 teeth on 0.2327 in to
 pinion 3 of 8 leaves (32:1 mean, as the involute train), gear tip-round centres on the pitch
 circles, radial pinion flanks meeting the tip round at the pinion pitch radius, tip rounds
@@ -70,7 +71,7 @@ import math
 from typing import Any
 
 from .base import ComponentError, Variable, common_outputs
-from .clock_train import M739_TRAIN, ClockMesh, ClockTrain
+from .clock_train_kinematics import M739_TRAIN, ClockMesh, ClockTrain
 from .escape_wheel import (
     ESCAPE_WHEEL_PORT,
     ESCAPE_WHEEL_VARIABLES,

@@ -14,7 +14,8 @@ Mesh models (parameter ``model``):
 1. involute mesh ``mesh`` = k of source 001 (Table k + 4, k = 1..9; the Appendix E mesh is k = 2)
    with friction ``mu`` at the teeth and both pivots: eqs. 46/47 (dual contact, equal load
    sharing) and A-26 (single contact), components.mesh_efficiency;
-2. clock mesh ``clock_mesh`` (1 or 2: M739_MESH1 / M739_MESH2 of components.clock_train) with the
+2. clock mesh ``clock_mesh`` (1 or 2: M739_MESH1 / M739_MESH2 of
+   components.clock_train_kinematics) with the
    derived round-on-round / round-on-flank efficiency (mesh_efficiency.train_mesh_efficiency,
    the statics of ClockMeshModel), pivot radii of the M739 input data.
 
@@ -52,8 +53,7 @@ from functools import cache
 import numpy as np
 
 from .base import COMMON_OUTPUTS, Component, ComponentError, Variable
-from .clock_train import M739_MESH1, M739_MESH2
-from .clock_train import ClockMesh as TrainClockMesh
+from .clock_train_kinematics import M739_MESH1, M739_MESH2, ClockMesh
 from .m739_data import M739
 from .mesh_efficiency import (
     LEGACY_PI,
@@ -90,7 +90,7 @@ REGIME_NAMES = {
 
 #: Clock meshes of the M739-like train and (gear, pinion) pivot radii of the M739 input data:
 #: mesh 1 rotor gear 1 -> pinion 2, mesh 2 gear 2 -> pinion 3 (escape wheel).
-CLOCK_MESHES: dict[int, tuple[TrainClockMesh, float, float]] = {
+CLOCK_MESHES: dict[int, tuple[ClockMesh, float, float]] = {
     1: (M739_MESH1, M739.rho1, M739.rho2),
     2: (M739_MESH2, M739.rho2, M739.rho3),
 }

@@ -32,8 +32,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import brentq
 
-from .clock_train import ClockMesh as TrainClockMesh
-from .mesh_efficiency_data import INCH, ClockMesh, InvoluteMesh
+from .clock_train_kinematics import ClockMesh
+from .mesh_efficiency_data import INCH, ClockMeshData, InvoluteMesh
 
 #: The programs' truncated pi and degree factor (note §4); only for regression to the printout.
 LEGACY_PI = 3.14159
@@ -289,7 +289,7 @@ class ClockMeshModel:
     continued below its arc centre by a straight flank (round-on-flank contact).
     """
 
-    def __init__(self, mesh: ClockMesh, center_distance: float | None = None) -> None:
+    def __init__(self, mesh: ClockMeshData, center_distance: float | None = None) -> None:
         self.mesh = mesh
         self.b = center_distance or (mesh.gear_pitch_radius + mesh.pinion_pitch_radius)
         cx_g = mesh.gear_arc_radius - 0.5 * mesh.gear_tooth_thickness
@@ -396,7 +396,7 @@ class ClockMeshModel:
 
 
 def clock_sweep(
-    mesh: ClockMesh, mus: tuple[float, ...] = MU_SWEEP, n: int = 200
+    mesh: ClockMeshData, mus: tuple[float, ...] = MU_SWEEP, n: int = 200
 ) -> tuple[np.ndarray, np.ndarray]:
     """(cycle efficiency, minimum point efficiency) of a clock mesh for each mu (Figs. 3–6)."""
     model = ClockMeshModel(mesh)
@@ -492,7 +492,7 @@ def involute_cycle_summary(geom: InvoluteGeometry, mu: float) -> CycleSummary:
 
 
 # ------------------------------------------------------------------------------------------
-# The derived clock efficiency on the two-pass train kinematics (components.clock_train)
+# The derived clock efficiency on the two-pass train kinematics (components.clock_train_kinematics)
 # ------------------------------------------------------------------------------------------
 @dataclass(frozen=True)
 class TrainMeshContact:
@@ -508,14 +508,14 @@ class TrainMeshContact:
     normal: np.ndarray  # unit normal of the force on the pinion
 
 
-def train_mesh_window(mesh: TrainClockMesh) -> tuple[float, float]:
+def train_mesh_window(mesh: ClockMesh) -> tuple[float, float]:
     """(start, length) of a tooth pair's window of gear angles, mesh-1 convention [rad]: the
     pair takes over at handover - pitch and hands over at handover."""
     pitch = 2.0 * math.pi / mesh.n_gear
     return mesh.handover() - pitch, pitch
 
 
-def _train_pair_contact(mesh: TrainClockMesh, local: float, phase: str) -> TrainMeshContact:
+def _train_pair_contact(mesh: ClockMesh, local: float, phase: str) -> TrainMeshContact:
     """Contact of the pair at gear angle ``local`` of its window, phase given (no reduction)."""
     s = -1.0 if mesh.mirrored else 1.0
     x = s * mesh.driven_angle(s * local, phase)  # pinion angle, mesh-1 convention
@@ -532,7 +532,7 @@ def _train_pair_contact(mesh: TrainClockMesh, local: float, phase: str) -> Train
     return TrainMeshContact(phase, local, x, ratio, o_p, c_g + mesh.rho_g * normal, normal)
 
 
-def train_mesh_contact(mesh: TrainClockMesh, phi1: float) -> TrainMeshContact:
+def train_mesh_contact(mesh: ClockMesh, phi1: float) -> TrainMeshContact:
     """Contact at gear angle phi1 [rad] (mesh-1 convention), any tooth pair."""
     start, pitch = train_mesh_window(mesh)
     k = math.floor((phi1 - start) / pitch)
@@ -551,19 +551,20 @@ def train_contact_efficiency(c: TrainMeshContact, mu: float, rho_g: float, rho_p
 
 
 def train_mesh_efficiency(
-    mesh: TrainClockMesh, mu: float, phi1: float, rho_gear: float, rho_pinion: float
+    mesh: ClockMesh, mu: float, phi1: float, rho_gear: float, rho_pinion: float
 ) -> tuple[float, float]:
     """(point efficiency, speed ratio d pinion / d gear) at gear angle phi1 (mesh-1 convention).
 
     The derived model of note §2.5 (the same statics as ClockMeshModel) on the kinematics of
-    components.clock_train: round-on-round, the normal through both round centres; round-on-
-    flank, through the gear round's centre square to the radial flank.  rho_*: pivot radii [m].
+    components.clock_train_kinematics: round-on-round, the normal through both round centres;
+    round-on-flank, through the gear round's centre square to the radial flank.
+    rho_*: pivot radii [m].
     """
     c = train_mesh_contact(mesh, phi1)
     return train_contact_efficiency(c, mu, rho_gear, rho_pinion), c.ratio
 
 
-def _train_sliding(mesh: TrainClockMesh, local: float, phase: str) -> float:
+def _train_sliding(mesh: ClockMesh, local: float, phase: str) -> float:
     """Sliding speed of the gear over the pinion along the common tangent, per unit gear speed."""
     c = _train_pair_contact(mesh, local, phase)
     r1, r2 = c.contact, c.contact - c.pinion_pivot
@@ -571,7 +572,7 @@ def _train_sliding(mesh: TrainClockMesh, local: float, phase: str) -> float:
     return _cross(c.normal, v)
 
 
-def train_mesh_breaks(mesh: TrainClockMesh) -> tuple[tuple[float, str], ...]:
+def train_mesh_breaks(mesh: ClockMesh) -> tuple[tuple[float, str], ...]:
     """Gear angles [rad] (mesh-1 convention) of one window where the contact phase changes,
     sorted, with their kind: "pair" (a new pair takes over: the window start), "contact"
     (round-on-round -> round-on-flank) and "pitch" (the sliding reverses: the contact crosses
@@ -598,7 +599,7 @@ def train_mesh_breaks(mesh: TrainClockMesh) -> tuple[tuple[float, str], ...]:
 
 
 def train_mesh_cycle_summary(
-    mesh: TrainClockMesh, mu: float, rho_gear: float, rho_pinion: float
+    mesh: ClockMesh, mu: float, rho_gear: float, rho_pinion: float
 ) -> CycleSummary:
     """CycleSummary of a clock_train mesh over one pair window (adaptive quadrature per phase).
 

@@ -96,7 +96,7 @@ ALFIN_ANOMALY_TABLES = (6, 7, 8, 12)
 
 
 @dataclass(frozen=True)
-class ClockMesh:
+class ClockMeshData:
     """Clock (constant-curvature tooth) mesh, Tables 1–4; the gear drives in all four."""
 
     table: int
@@ -115,13 +115,13 @@ class ClockMesh:
     pinion_pivot_radius: float  # m
 
 
-def _clock(table, name, ng, np_, rg, rp, ag, ap, qg, qp, tg, tp, pg, pp) -> ClockMesh:
+def _clock(table, name, ng, np_, rg, rp, ag, ap, qg, qp, tg, tp, pg, pp) -> ClockMeshData:
     i = INCH
-    return ClockMesh(table, name, ng, np_, rg * i, rp * i, ag * i, ap * i, qg * i, qp * i,
+    return ClockMeshData(table, name, ng, np_, rg * i, rp * i, ag * i, ap * i, qg * i, qp * i,
                      tg * i, tp * i, pg * i, pp * i)  # fmt: skip
 
 
-CLOCK_MESHES: dict[int, ClockMesh] = {
+CLOCK_MESHES: dict[int, ClockMeshData] = {
     m.table: m
     for m in (
         _clock(1, "propulsion timer gear & pinion", 72, 18, 0.360, 0.090, 0.3577, 0.09012,

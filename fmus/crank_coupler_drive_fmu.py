@@ -4,6 +4,6 @@ from component_slave import ComponentSlave
 
 
 class CrankCouplerDrive(ComponentSlave):
-    component = "rssr_coupler.CrankCouplerDrive"
+    component = "crank_coupler_drive.CrankCouplerDrive"
     description = "Press-feed crank drive: RSSR linkage with an elastic bent coupler"
     default_run = (0.0, 0.01, 1.0e-5)

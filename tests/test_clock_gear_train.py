@@ -18,7 +18,7 @@ from components.clock_gear_train import (
     ClockGearTrain,
     ClockTrainPhysics,
 )
-from components.clock_train import INCH, M739_CD_SWEEP, M739_ESCAPEMENT_CD, M739_TRAIN
+from components.clock_train_kinematics import INCH, M739_CD_SWEEP, M739_ESCAPEMENT_CD, M739_TRAIN
 from components.m739_data import M739
 from components.mesh_efficiency import contact_efficiency
 from components.verge_escapement import VergeEscapement, escapement_data

@@ -12,7 +12,7 @@ import pytest
 from scipy.integrate import quad
 
 from components.base import ComponentError
-from components.clock_train import M739_MESH1, M739_MESH2
+from components.clock_train_kinematics import M739_MESH1, M739_MESH2
 from components.gear_mesh import (
     DUAL_MIXED,
     MODEL_CLOCK,

@@ -16,6 +16,13 @@ from components.brake_load import (
     REGIME_STICK,
     BrakeLoad,
 )
+from components.crank_coupler_drive import (
+    CrankCouplerDrive,
+    coupler_damping,
+    coupler_modal_mass,
+    coupler_stiffness,
+    strain_factors,
+)
 from components.press_feed_data import (
     APP_H_END_VALUES,
     APP_H_F2,
@@ -38,13 +45,6 @@ from components.press_feed_data import (
     PART2_BRAKE_TORQUES,
     RUNS,
     TABLE4,
-)
-from components.rssr_coupler import (
-    CrankCouplerDrive,
-    coupler_damping,
-    coupler_modal_mass,
-    coupler_stiffness,
-    strain_factors,
 )
 from components.rssr_kinematics import ExactRSSR, rocker_extremes
 from components.sprag_clutch import (

@@ -6,7 +6,7 @@ does for the involute train; a tooth handover is an inelastic impact of the new 
 from __future__ import annotations
 
 from components.clock_gear_train import LOSS_POINT, ClockTrainPhysics
-from components.clock_train import M739_TRAIN
+from components.clock_train_kinematics import M739_TRAIN
 from components.m739_data import M739, rpm_to_rad_s
 from components.verge_escapement import (
     IND_MESH_HI,

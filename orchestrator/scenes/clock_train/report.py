@@ -1,7 +1,8 @@
 """The clock-train S&A scenes: the M739 verge escapement behind a two-pass clock gear train.
 
 Two FMUs meet at the escape-wheel shaft: ``train`` (ClockGearTrain: the M739 spin-driven rotor
-and the clock train of ``components.clock_train``) and ``verge`` (VergeEscapement, with its
+and the clock train of ``components.clock_train_kinematics``) and ``verge`` (VergeEscapement,
+with its
 escapement centre distance as a parameter).  Arming is the rotor's: the run stops when the rotor
 has turned as far as the M739's does to arm (``scene.stop_when`` on ``train.rotor_angle``;
 1485 deg of escape wheel over 32 on the M739).  The clock ratio ripples, so the escape-wheel

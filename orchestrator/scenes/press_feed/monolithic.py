@@ -42,6 +42,14 @@ from components.brake_load import (
     shaft_acceleration,
     slip_direction,
 )
+from components.crank_coupler_drive import (
+    DriveModel,
+    build_drive_model,
+    coupler_derivatives,
+    coupler_energy,
+    rocker_motion,
+    strain_factors,
+)
 from components.press_feed_data import (
     APP_H_F2,
     APP_H_FOURIER,
@@ -65,14 +73,6 @@ from components.press_feed_data import (
     RUNS,
     BentCoupler,
     RSSRLinkage,
-)
-from components.rssr_coupler import (
-    DriveModel,
-    build_drive_model,
-    coupler_derivatives,
-    coupler_energy,
-    rocker_motion,
-    strain_factors,
 )
 from components.rssr_kinematics import ExactRSSR, rocker_extremes
 from components.sprag_clutch import (

@@ -23,6 +23,8 @@ import numpy as np
 
 from components.brake_load import REGIME_NAMES as BRAKE_NAMES
 from components.brake_load import REGIME_SLIP_FORWARD, REGIME_STICK, BrakeLoad
+from components.crank_coupler_drive import REGIME_FORWARD, CrankCouplerDrive, build_drive_model
+from components.crank_coupler_drive import REGIME_NAMES as DRIVE_NAMES
 from components.press_feed_data import (
     C_NL,
     C_SP,
@@ -32,8 +34,6 @@ from components.press_feed_data import (
     BentCoupler,
     RSSRLinkage,
 )
-from components.rssr_coupler import REGIME_FORWARD, CrankCouplerDrive, build_drive_model
-from components.rssr_coupler import REGIME_NAMES as DRIVE_NAMES
 from components.rssr_kinematics import ExactRSSR, rocker_extremes
 from components.sprag_clutch import MODEL_HERTZ, MODEL_LUMPED, REGIME_ENGAGED, SpragClutch
 from components.sprag_clutch import REGIME_NAMES as CLUTCH_NAMES

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from components.clock_train import (
+from components.clock_train_kinematics import (
     M739_CD_SWEEP,
     M739_MESH1,
     M739_MESH2,
