@@ -38,6 +38,8 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import brentq
 
+from .units import INCH
+
 _TWO_PI = 2.0 * math.pi
 PHASES = ("auto", "ror", "rof")
 
@@ -402,9 +404,6 @@ class ClockTrain:
         phi2p, r1, d1 = self.mesh1._forward(phi1, "auto")
         _, r2, d2 = self.mesh2._forward(phi2p + self.kappa2, "auto")
         return d2 * r1 * r1 + r2 * d1
-
-
-INCH = 0.0254  # m
 
 
 def _m739_mesh(center_distance_in: float, n_gear: int, n_pinion: int, mirrored: bool) -> ClockMesh:

@@ -29,11 +29,11 @@ from .press_feed_data import (
     IN,
     J_O4,
     LINKAGE_TABLE1,
-    RPM,
     BentCoupler,
     RSSRLinkage,
 )
 from .rssr_kinematics import ExactRSSR, FourierRocker, rocker_extremes
+from .units import RPM
 
 REGIME_RETURN = 0  # rocker moving back (theta4 decreasing)
 REGIME_FORWARD = 1  # rocker on the feed stroke (theta4 increasing)

@@ -9,8 +9,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-#: 1 lbf.in in N.m (4.4482216152605 N x 0.0254 m).
-LBF_IN = 0.1129848290276167
+from .units import LBF_IN
 
 #: Balance inertia of the worked example, 1.10e-7 lb.in.s^2 (note §4), in kg.m^2.
 BALANCE_INERTIA = 1.10e-7 * LBF_IN

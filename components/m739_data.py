@@ -11,18 +11,11 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 
-# Conversion factors (exact by definition of the inch and the pound-force).
-INCH = 0.0254  # m
-LBF = 4.4482216152605  # N
+from .units import DEG, INCH, LBF, rpm_to_rad_s
+
 MASS_US = LBF / INCH  # kg per lb.s^2/in
 INERTIA_US = LBF * INCH  # kg.m^2 per in.lb.s^2
 TORQUE_US = LBF * INCH  # N.m per in.lb
-DEG = math.pi / 180.0
-
-
-def rpm_to_rad_s(rpm: float) -> float:
-    """Spin rate in rev/min to rad/s."""
-    return rpm * 2.0 * math.pi / 60.0
 
 
 @dataclass(frozen=True)

@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-INCH = 0.0254  # m
+from .units import INCH
 
 
 @dataclass(frozen=True)

@@ -12,14 +12,11 @@ import math
 from dataclasses import dataclass, replace
 
 # -- unit factors (exact definitions) -------------------------------------------------------
-IN = 0.0254  # m per inch
-LBF = 4.4482216152605  # N per lbf
-LBF_IN = LBF * IN  # N.m per lbf.in (torque; also inertia lbf.in.s^2 -> kg.m^2)
-LB_PER_IN = LBF / IN  # N/m per lbf/in (stiffness; also mass lbf.s^2/in -> kg)
-PSI = LBF / IN**2  # Pa per lbf/in^2
+from .units import INCH as IN
+from .units import LB_PER_IN, LBF, LBF_IN, PSI
+
 RHO_UNIT = LBF / IN**4  # kg/m^3 per lbf.s^2/in^4
 G_STD = 9.80665  # m/s^2, converts the 9.1 lb lumped weight
-RPM = 2.0 * math.pi / 60.0  # rad/s per rev/min
 
 
 @dataclass(frozen=True)

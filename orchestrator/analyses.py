@@ -11,6 +11,7 @@ from typing import Any
 import numpy as np
 
 from orchestrator.scenario import Scene
+from orchestrator.scenes.family import Quantity, quantity
 
 _REDUCE: dict[str, Callable[[np.ndarray], float]] = {
     "final": lambda x: x[-1],
@@ -22,14 +23,14 @@ _REDUCE: dict[str, Callable[[np.ndarray], float]] = {
 }
 
 
-def headline(scene: Scene, header: list[str], data: np.ndarray) -> dict[str, dict[str, Any]]:
+def headline(scene: Scene, header: list[str], data: np.ndarray) -> dict[str, Quantity]:
     """The scene's [report.headline] quantities, each with its SI unit."""
-    out: dict[str, dict[str, Any]] = {}
+    out: dict[str, Quantity] = {}
     if len(data) == 0:
         return out
     for name, spec in scene.headline.items():
         column = data[:, header.index(".".join(spec.signal))]
-        out[name] = {"value": float(_REDUCE[spec.reduce](column)), "unit": spec.unit}
+        out[name] = quantity(_REDUCE[spec.reduce](column), spec.unit)
     return out
 
 

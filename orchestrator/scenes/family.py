@@ -9,9 +9,21 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, TypedDict
 
 import numpy as np
+
+
+class Quantity(TypedDict):
+    """A headline value of a run or a reference, with its SI unit (as summary.json holds it)."""
+
+    value: float
+    unit: str
+
+
+def quantity(value: float, unit: str) -> Quantity:
+    """A headline value; numpy scalars become plain floats (for JSON)."""
+    return {"value": float(value), "unit": unit}
 
 
 @dataclass
@@ -83,7 +95,7 @@ class SceneFamily:
     """One family of scenes (``[report] analysis`` / ``reference`` name it): what it reads,
     and where its analysis, plot and reference live ("module:function", imported when used).
 
-    analysis: (scene, header, data, options) -> {name: {"value", "unit"}}
+    analysis: (scene, header, data, options) -> {name: Quantity}
     plot: (scene, header, data, path) -> None, writing a PNG at path
     reference: (scene) -> Reference, the monolithic yardstick of the coupling error
     """

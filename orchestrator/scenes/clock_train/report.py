@@ -23,23 +23,21 @@ from typing import Any
 
 import numpy as np
 
+from components.units import RPM_PER_RAD_S
 from components.verge_escapement import (
     FREE,
 )
 from orchestrator.scenario import Scene
 from orchestrator.scenes.clock_train.monolithic import ARMING_ROTOR_ANGLE, run_clock_train
-from orchestrator.scenes.family import Reference
+from orchestrator.scenes.family import Quantity, Reference, quantity
 from orchestrator.scenes.m739.report import (
     _names,
     _parameter,
-    _q,
     _why_not_armed,
     escapement_figure,
     reference_from,
     save_figure,
 )
-
-RPM_PER_RAD_S = 60.0 / (2.0 * math.pi)
 
 
 def _arming(scene: Scene, train: str) -> tuple[str, float, bool]:
@@ -63,7 +61,7 @@ def _crossing(t: np.ndarray, x: np.ndarray, level: float, rising: bool) -> float
 
 def analyse(
     scene: Scene, header: list[str], data: np.ndarray, options: dict[str, Any]
-) -> dict[str, Any]:
+) -> dict[str, Quantity]:
     """Turns to arm (or why not), escape-wheel angle at arming, force maxima, impacts,
     tooth handovers."""
     train, verge = _names(scene)
@@ -74,21 +72,21 @@ def analyse(
     out: dict[str, Any] = {}
     t_arm = _crossing(t, col[signal], level, rising) if signal in col else None
     if t_arm is not None:
-        out["armed"] = _q(1.0, "1")
-        out["arming_time"] = _q(t_arm, "s")
-        out["turns_to_arm"] = _q(t_arm * abs(spin) / (2.0 * math.pi), "1")
-        out["phi_at_arming"] = _q(float(np.interp(t_arm, t, col[f"{train}.phi"])), "rad")
+        out["armed"] = quantity(1.0, "1")
+        out["arming_time"] = quantity(t_arm, "s")
+        out["turns_to_arm"] = quantity(t_arm * abs(spin) / (2.0 * math.pi), "1")
+        out["phi_at_arming"] = quantity(float(np.interp(t_arm, t, col[f"{train}.phi"])), "rad")
     else:
-        out["armed"] = _q(0.0, "1")
+        out["armed"] = quantity(0.0, "1")
         out["not_armed_reason"] = {"value": _why_not_armed(scene, col, train), "unit": ""}
     coupled = col[f"{verge}.regime"] != FREE
     for name, mask in (("F23", coupled), ("F12", coupled), ("FF23", ~coupled), ("FF12", ~coupled)):
         source = col[f"{train}.{name}"]  # F*: coupled motion, FF*: free motion (as the M739's)
-        out[f"{name}_max"] = _q(float(np.max(source[mask])) if mask.any() else 0.0, "N")
-    out["PN_max"] = _q(float(np.max(col[f"{verge}.PN"])), "N")
-    out["impacts"] = _q(float(col[f"{verge}.impact_count"][-1]), "1")
+        out[f"{name}_max"] = quantity(float(np.max(source[mask])) if mask.any() else 0.0, "N")
+    out["PN_max"] = quantity(float(np.max(col[f"{verge}.PN"])), "N")
+    out["impacts"] = quantity(float(col[f"{verge}.impact_count"][-1]), "1")
     if f"{train}.handovers" in col:
-        out["handovers"] = _q(float(col[f"{train}.handovers"][-1]), "1")
+        out["handovers"] = quantity(float(col[f"{train}.handovers"][-1]), "1")
     return out
 
 

@@ -45,7 +45,7 @@ from orchestrator.errors import ScenarioError
 from orchestrator.scenario import Scene
 from orchestrator.scenes.detached_lever.lever import LeverScene, lever_scene
 from orchestrator.scenes.detached_lever.monolithic import beat_run
-from orchestrator.scenes.family import Reference
+from orchestrator.scenes.family import Quantity, Reference, quantity
 
 SECONDS_PER_DAY = 86400.0
 #: Cycles whose amplitude is reported by name (the note's §7 A lists 1-10, 20 and 41).
@@ -53,10 +53,6 @@ NAMED_CYCLES = (1, 2, 3, 10, 20, 41)
 
 
 # -- reductions of a recorded run -------------------------------------------------------------
-def _q(value: float, unit: str) -> dict[str, Any]:
-    return {"value": float(value), "unit": unit}
-
-
 def _columns(header: list[str], data: np.ndarray, instance: str) -> dict[str, np.ndarray]:
     prefix = f"{instance}."
     col = {"time": data[:, 0]}
@@ -118,7 +114,7 @@ def rate(lever: LeverScene, period: float) -> float:
 
 def analyse(
     scene: Scene, header: list[str], data: np.ndarray, options: dict[str, Any]
-) -> dict[str, Any]:
+) -> dict[str, Quantity]:
     """Per-cycle and steady amplitude, period and rate, beats, overbank, energy balance."""
     lever = lever_scene(scene)
     col = _columns(header, data, lever.instance)
@@ -130,63 +126,65 @@ def analyse(
             scene.path, "output.record", f"the lever analysis needs {lever.instance}.{missing[0]}"
         )
     out: dict[str, Any] = {
-        "switching_mode": _q(lever.mode, "1"),
-        "drive_torque": _q(lever.drive_torque, "N.m"),
-        "free_period": _q(lever.free_period, "s"),
-        "nominal_period": _q(lever.nominal_period, "s"),
+        "switching_mode": quantity(lever.mode, "1"),
+        "drive_torque": quantity(lever.drive_torque, "N.m"),
+        "free_period": quantity(lever.free_period, "s"),
+        "nominal_period": quantity(lever.nominal_period, "s"),
     }
     unit, k_cuc = lever.table_i_unit(), lever.table_i_k()
     if unit is not None:
-        out["table_i_unit"] = _q(unit, "1")
+        out["table_i_unit"] = quantity(unit, "1")
     if lever.load_step is not None:
-        out["load_multiple"] = _q(lever.load_multiple(), "1")
+        out["load_multiple"] = quantity(lever.load_multiple(), "1")
     if k_cuc is not None:
         # the thesis's computed unit curve at this unit and load (note §5.1): what the
         # angle-switched model's friction and drive were refitted to
-        out["cuc_steady_amplitude"] = _q(
+        out["cuc_steady_amplitude"] = quantity(
             unit_curve_steady(TABLE_I[unit].c_over_omega0, k_cuc), "rad"
         )
     n, _, amps = cycle_amplitudes(lever, col)
-    out["cycles"] = _q(n[-1], "1")
+    out["cycles"] = quantity(n[-1], "1")
     for k in NAMED_CYCLES:
         at = np.nonzero(n == k)[0]  # absent if a macro step spanned a whole cycle
         if len(at):
-            out[f"amplitude_cycle_{k}"] = _q(amps[at[0]], "rad")
+            out[f"amplitude_cycle_{k}"] = quantity(amps[at[0]], "rad")
     stopped = int(col["regime"][-1]) == STOPPED
-    out["stopped"] = _q(1.0 if stopped else 0.0, "1")
+    out["stopped"] = quantity(1.0 if stopped else 0.0, "1")
     if stopped:
         moving = np.nonzero(col["regime"] != STOPPED)[0]
-        out["stop_time"] = _q(col["time"][moving[-1] + 1] if len(moving) else col["time"][0], "s")
-        out["steady_amplitude"] = _q(0.0, "rad")  # the balance rests
+        out["stop_time"] = quantity(
+            col["time"][moving[-1] + 1] if len(moving) else col["time"][0], "s"
+        )
+        out["steady_amplitude"] = quantity(0.0, "rad")  # the balance rests
     elif n[-1] >= 1:
-        out["final_amplitude"] = _q(amps[-1], "rad")
+        out["final_amplitude"] = quantity(amps[-1], "rad")
         steady = aitken(amps)
-        out["steady_amplitude"] = _q(steady, "rad")
-        out["amplitude_settling"] = _q(abs(amps[-1] - steady), "rad")
+        out["steady_amplitude"] = quantity(steady, "rad")
+        out["amplitude_settling"] = quantity(abs(amps[-1] - steady), "rad")
         # Mode 0 schedules its windows on the phase: the cycle lasts 2 pi / omega1 by
         # construction (note §0.4), and the speed may reverse inside a cycle (the draw can stop
         # the balance before the impulse restarts it), so extremes do not measure it.
         period = lever.free_period if lever.mode == PHASE_SCHEDULED else float(col["period"][-1])
         if period > 0.0:
-            out["period"] = _q(period, "s")
-            out["rate"] = _q(rate(lever, period), "s/day")
-    out["beats"] = _q(col["beat_count"][-1], "1")
+            out["period"] = quantity(period, "s")
+            out["rate"] = quantity(rate(lever, period), "s/day")
+    out["beats"] = quantity(col["beat_count"][-1], "1")
     if lever.mode == PHASE_SCHEDULED and n[-1] >= 2:
         # speed reversals in the last complete cycle (2 for a plain oscillation)
         count = col["cycle_count"].astype(int)
         ends = np.nonzero(np.diff(count) > 0)[0] + 1
         beats = col["beat_count"]
-        out["beats_last_cycle"] = _q(beats[ends[-1]] - beats[ends[-2]], "1")
+        out["beats_last_cycle"] = quantity(beats[ends[-1]] - beats[ends[-2]], "1")
     if "overbanked" in col:
-        out["overbanked"] = _q(col["overbanked"][-1], "1")
+        out["overbanked"] = quantity(col["overbanked"][-1], "1")
     if "drive_work" in col:
-        out["drive_work"] = _q(col["drive_work"][-1], "J")
+        out["drive_work"] = quantity(col["drive_work"][-1], "J")
     if "dissipated_work" in col:
-        out["dissipated_work"] = _q(col["dissipated_work"][-1], "J")
+        out["dissipated_work"] = quantity(col["dissipated_work"][-1], "J")
     residual = lever_energy_residual(col)
     if residual is not None and not lever.driven_from_scene:
         # The drive torque comes from outside the scene here: its work enters the balance.
-        out["energy_residual"] = _q(residual, "1")
+        out["energy_residual"] = quantity(residual, "1")
     return out
 
 

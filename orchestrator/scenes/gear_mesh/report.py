@@ -54,7 +54,7 @@ from components.mesh_efficiency import (
 )
 from orchestrator.errors import ScenarioError
 from orchestrator.scenario import Scene
-from orchestrator.scenes.family import Reference
+from orchestrator.scenes.family import Quantity, Reference, quantity
 
 #: Names of the efficiency on the (left, right) side of each kind of contact change.
 _SIDES = {
@@ -139,10 +139,6 @@ def _break_kind(m: MeshModel, theta: float) -> str:
     return m.kinds[best]
 
 
-def _q(value: float, unit: str) -> dict[str, Any]:
-    return {"value": float(value), "unit": unit}
-
-
 def _units(name: str) -> str:
     return {"mean_driver_torque": "N.m"}.get(name, "1")
 
@@ -150,7 +146,7 @@ def _units(name: str) -> str:
 # -- analysis of a run -----------------------------------------------------------------------
 def analyse(
     scene: Scene, header: list[str], data: np.ndarray, options: dict[str, Any]
-) -> dict[str, dict[str, Any]]:
+) -> dict[str, Quantity]:
     """Headline quantities of a gear-mesh run over its whole mesh cycles (module doc).
 
     Needs recorded: driver_angle, efficiency, regime, input_work, output_work, dissipated_work
@@ -162,30 +158,32 @@ def analyse(
     theta = col[f"{p}.driver_angle"]
     eff = col[f"{p}.efficiency"]
     w_in, w_out = col[f"{p}.input_work"], col[f"{p}.output_work"]
-    out: dict[str, dict[str, Any]] = {}
+    out: dict[str, Quantity] = {}
     stored = col.get(f"{p}.stored_energy", np.zeros_like(w_in))
     balance = w_in - w_out - col[f"{p}.dissipated_work"] - stored
     scale = float(np.max(np.abs(w_in)))
     if scale > 0.0:
-        out["energy_residual"] = _q(np.max(np.abs(balance)) / scale, "1")
+        out["energy_residual"] = quantity(np.max(np.abs(balance)) / scale, "1")
     begin, n = _whole_cycles(ms, float(theta[0]), float(theta[-1]))
-    out["whole_cycles"] = _q(n, "1")
+    out["whole_cycles"] = quantity(n, "1")
     if n == 0:
         return out
     end = begin + n * ms.model.cycle
     wi0, wi1 = np.interp([begin, end], theta, w_in)
     wo0, wo1 = np.interp([begin, end], theta, w_out)
     if wi1 > wi0:
-        out["cycle_efficiency"] = _q((wo1 - wo0) / (wi1 - wi0), "1")
-    out["mean_driver_torque"] = _q((wi1 - wi0) / (end - begin), "N.m")
+        out["cycle_efficiency"] = quantity((wo1 - wo0) / (wi1 - wi0), "1")
+    out["mean_driver_torque"] = quantity((wi1 - wi0) / (end - begin), "N.m")
     tol = 1e-9 * ms.model.cycle
     inside = (theta >= begin - tol) & (theta <= end + tol)
-    out["min_efficiency"] = _q(np.min(eff[inside]), "1")
-    out["max_efficiency"] = _q(np.max(eff[inside]), "1")
+    out["min_efficiency"] = quantity(np.min(eff[inside]), "1")
+    out["max_efficiency"] = quantity(np.max(eff[inside]), "1")
     # Driver-angle mean: trapezoids between samples (both sides of each jump are recorded).
     x = np.concatenate(([begin], theta[(theta > begin) & (theta < end)], [end]))
     y = np.interp(x, theta, eff)
-    out["mean_efficiency"] = _q(np.sum(0.5 * (y[1:] + y[:-1]) * np.diff(x)) / (end - begin), "1")
+    out["mean_efficiency"] = quantity(
+        np.sum(0.5 * (y[1:] + y[:-1]) * np.diff(x)) / (end - begin), "1"
+    )
     regime = col[f"{p}.regime"].astype(int)
     sides: dict[str, list[float]] = {}
     for i in np.nonzero(np.diff(regime))[0]:
@@ -198,7 +196,7 @@ def analyse(
             sides.setdefault(left, []).append(float(eff[i]))
             sides.setdefault(right, []).append(float(eff[i + 1]))
     for name, values in sides.items():
-        out[name] = _q(np.mean(values), "1")
+        out[name] = quantity(np.mean(values), "1")
     return out
 
 

@@ -15,12 +15,11 @@ from typing import Any
 import numpy as np
 
 from components.m739_data import LBF, M739
+from components.units import RPM_PER_RAD_S
 from components.verge_escapement import FREE, REGIME_NAMES, escapement_data
 from orchestrator.scenario import Scene
-from orchestrator.scenes.family import Reference
+from orchestrator.scenes.family import Quantity, Reference, quantity
 from orchestrator.scenes.m739.monolithic import run_m739
-
-RPM_PER_RAD_S = 60.0 / (2.0 * math.pi)
 
 
 def _names(scene: Scene) -> tuple[str, str]:
@@ -40,13 +39,9 @@ def _arming_angle(scene: Scene) -> float:
     return cond.threshold if cond is not None else M739.phi_cut
 
 
-def _q(value: float, unit: str) -> dict[str, Any]:
-    return {"value": float(value), "unit": unit}
-
-
 def analyse(
     scene: Scene, header: list[str], data: np.ndarray, options: dict[str, Any]
-) -> dict[str, Any]:
+) -> dict[str, Quantity]:
     """Turns to arm (or why not), arming time, force maxima by regime, impacts."""
     train, verge = _names(scene)
     col = {name: data[:, i] for i, name in enumerate(header)}
@@ -61,19 +56,19 @@ def analyse(
             t_arm = t[k]
         else:  # a fixed-step master stops past the angle: interpolate within the last step
             t_arm = t[k - 1] + (t[k] - t[k - 1]) * (phi_cut - phi[k - 1]) / (phi[k] - phi[k - 1])
-        out["armed"] = _q(1.0, "1")
-        out["arming_time"] = _q(t_arm, "s")
-        out["turns_to_arm"] = _q(t_arm * abs(spin) / (2.0 * math.pi), "1")
+        out["armed"] = quantity(1.0, "1")
+        out["arming_time"] = quantity(t_arm, "s")
+        out["turns_to_arm"] = quantity(t_arm * abs(spin) / (2.0 * math.pi), "1")
     else:
-        out["armed"] = _q(0.0, "1")
+        out["armed"] = quantity(0.0, "1")
         out["not_armed_reason"] = {"value": _why_not_armed(scene, col, train), "unit": ""}
     regime = col[f"{verge}.regime"]
     coupled = regime != FREE
     for name, mask in (("F23", coupled), ("F12", coupled), ("FF23", ~coupled), ("FF12", ~coupled)):
         source = col[f"{train}.{name}"]  # F*: coupled motion, FF*: free motion (the report's)
-        out[f"{name}_max"] = _q(float(np.max(source[mask])) if mask.any() else 0.0, "N")
-    out["PN_max"] = _q(float(np.max(col[f"{verge}.PN"])), "N")
-    out["impacts"] = _q(float(col[f"{verge}.impact_count"][-1]), "1")
+        out[f"{name}_max"] = quantity(float(np.max(source[mask])) if mask.any() else 0.0, "N")
+    out["PN_max"] = quantity(float(np.max(col[f"{verge}.PN"])), "N")
+    out["impacts"] = quantity(float(col[f"{verge}.impact_count"][-1]), "1")
     return out
 
 

@@ -86,6 +86,7 @@ from components.sprag_clutch import (
     two_point_hertz,
     unwinding_stiffness,
 )
+from components.units import rpm_to_rad_s
 
 WINDUP, FEED, UNWIND, OVERRUN = 1, 2, 3, 4
 # state vector: q, q', theta5, theta5', W_in, D_coupler, D_clutch, D_brake, and, while the
@@ -453,7 +454,7 @@ def _integrate(mach, y0: np.ndarray, t_end: float, o: FeedOptions, grid: np.ndar
 def simulate_feed(o: FeedOptions = FeedOptions()) -> FeedResult:
     """Run the press feed for o.cycles crank revolutions from the rocker's extreme."""
     mach, y0, rpm = _setup(o)
-    omega = rpm * 2.0 * math.pi / 60.0
+    omega = rpm_to_rad_s(rpm)
     period = 2.0 * math.pi / omega
     t_end = o.cycles * period
     grid = np.linspace(0.0, t_end, o.cycles * o.samples_per_cycle + 1)

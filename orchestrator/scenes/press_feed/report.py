@@ -30,15 +30,15 @@ from components.press_feed_data import (
     C_SP,
     K_SP,
     N_DAMP,
-    RPM,
     BentCoupler,
     RSSRLinkage,
 )
 from components.rssr_kinematics import ExactRSSR, rocker_extremes
 from components.sprag_clutch import MODEL_HERTZ, MODEL_LUMPED, REGIME_ENGAGED, SpragClutch
 from components.sprag_clutch import REGIME_NAMES as CLUTCH_NAMES
+from components.units import RPM
 from orchestrator.scenario import Scene
-from orchestrator.scenes.family import Reference
+from orchestrator.scenes.family import Quantity, Reference, quantity
 from orchestrator.scenes.press_feed.monolithic import (
     FeedOptions,
     peak_to_trough_ratios,
@@ -225,14 +225,10 @@ def _normal_cycles(n: int, startup: int) -> range:
     return range(startup, n) if n > startup else range(n)
 
 
-def _q(value: float, unit: str) -> dict[str, Any]:
-    return {"value": float(value), "unit": unit}
-
-
 # -- analysis of a run ---------------------------------------------------------------------------
 def analyse(
     scene: Scene, header: list[str], data: np.ndarray, options: dict[str, Any]
-) -> dict[str, dict[str, Any]]:
+) -> dict[str, Quantity]:
     """Headline quantities of a press-feed run (see the module doc for the definitions).
 
     Needs recorded: drive.regime, clutch.regime, clutch.windup, load.regime,
@@ -245,7 +241,7 @@ def analyse(
     col = {name: data[:, i] for i, name in enumerate(header)}
     t = col["time"] - scene.start
     n = _complete_cycles(t[-1], fs.period)
-    out: dict[str, dict[str, Any]] = {}
+    out: dict[str, Quantity] = {}
     if n == 0:
         raise ValueError(_no_cycle(t[-1], fs.period))
     startup = int(options.get("startup_cycles", 1))
@@ -256,33 +252,33 @@ def analyse(
     feed_len = col[f"{fs.load}.feed_length"]
     bounds = np.interp(np.arange(n + 1) * fs.period, t, feed_len)
     per_cycle = np.diff(bounds)
-    out["feed_length_mean"] = _q(np.mean(per_cycle[list(normal)]), "m")
-    out["feed_length_last"] = _q(per_cycle[-1], "m")
+    out["feed_length_mean"] = quantity(np.mean(per_cycle[list(normal)]), "m")
+    out["feed_length_last"] = quantity(per_cycle[-1], "m")
     windup = col[f"{fs.clutch}.windup"]
     in_run = t <= n * fs.period + 1e-12
-    out["peak_windup"] = _q(np.max(windup[in_run]), "rad")
+    out["peak_windup"] = quantity(np.max(windup[in_run]), "rad")
     cycle_of = np.floor(t / fs.period + 1e-12).astype(int)
     sel = np.isin(cycle_of, list(normal)) & (col[f"{fs.load}.regime"] == REGIME_SLIP_FORWARD)
     if sel.any():
-        out["mean_windup_feed"] = _q(time_mean(t, windup, sel), "rad")
+        out["mean_windup_feed"] = quantity(time_mean(t, windup, sel), "rad")
     if not fs.rigid:
         for name, signal, unit in (
             ("peak_deflection", "q", "m"),
             ("peak_strain", "strain", "1"),
             ("peak_strain_b", "strain_b", "1"),
         ):
-            out[name] = _q(np.max(np.abs(col[f"{fs.drive}.{signal}"][in_run])), unit)
+            out[name] = quantity(np.max(np.abs(col[f"{fs.drive}.{signal}"][in_run])), unit)
     trans = transitions_from_samples(t, regime)
     timing = regime_timing(trans, (n - 1) * fs.period, n * fs.period, fs.omega, fs.crank_start())
     for name, value in timing.items():
-        out[name] = _q(value, "rad" if name.endswith("angle") else "1")
+        out[name] = quantity(value, "rad" if name.endswith("angle") else "1")
     if options.get("decay_ratios", False):
         ratios = decay_ratios(windup, (cycle_of == n - 1) & (regime == FEED))
         if ratios:
-            out["decay_ratio"] = _q(np.mean(ratios[:DECAY_PEAKS]), "1")
+            out["decay_ratio"] = quantity(np.mean(ratios[:DECAY_PEAKS]), "1")
     ext = f"{fs.drive}.external_work"
     if ext in col:
-        out["crank_work_per_cycle"] = _q(
+        out["crank_work_per_cycle"] = quantity(
             np.diff(np.interp([0, n * fs.period], t, col[ext]))[0] / n, "J"
         )
     return out
