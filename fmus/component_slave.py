@@ -53,6 +53,9 @@ class ComponentSlave(Fmi2Slave):
 
     #: "module.Class" of the component, the module inside the ``components`` package
     component: ClassVar[str]
+    #: scenes (paths from the project root) that couple it with other FMUs; read, not run,
+    #: by ``fmus.registry`` for the FMU's documentation
+    examples: ClassVar[tuple[str, ...]] = ()
     description: ClassVar[str] = ""
     #: (start, stop, step) of the experiment `fmpy simulate` runs when given the FMU alone
     default_run: ClassVar[tuple[float, float, float]] = (0.0, 1.0, 1.0e-3)

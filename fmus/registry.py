@@ -1,5 +1,6 @@
-"""Which FMUs exist: the name a scene uses, the wrapper script, the component inside, and
-the example scenes that couple it with other FMUs (listed in its documentation)."""
+"""Which FMUs exist, read from the wrapper scripts ``fmus/*_fmu.py``: the name a scene uses (the
+script's ComponentSlave class), the script, the component inside, and the example scenes that
+couple it with other FMUs (listed in its documentation)."""
 
 from __future__ import annotations
 
@@ -15,8 +16,8 @@ _HERE = Path(__file__).resolve().parent
 class FmuWrapper:
     name: str  # model identifier, as a scene names it
     script: Path  # pythonfmu script with exactly one ComponentSlave subclass
-    #: Scenes (paths relative to the project root) that couple this FMU with others; the
-    #: FMU's documentation lists their connections.  Empty: no scene couples it.
+    #: Scenes (paths relative to the project root) that couple this FMU with others, from the
+    #: script's ``examples``; the FMU's documentation lists their connections.
     examples: tuple[str, ...] = ()
 
     @cached_property
@@ -33,46 +34,27 @@ class FmuWrapper:
         raise ValueError(f"{self.script} names no component (component = 'module.Class')")
 
 
-def _wrapper(name: str, module: str, *examples: str) -> FmuWrapper:
-    return FmuWrapper(name, _HERE / f"{module}.py", tuple(examples))
+def _literal(cls: ast.ClassDef, name: str) -> object:
+    for node in cls.body:
+        if isinstance(node, ast.Assign) and [getattr(t, "id", None) for t in node.targets] == [
+            name
+        ]:
+            return ast.literal_eval(node.value)
+    return None
 
 
-_TWO_INERTIAS = "scenarios/two_inertias.toml"
-_M739 = "scenarios/m739.toml"
-_CLOCK_TRAIN = "scenarios/clock_train_sa.toml"
-_PRESS_FEED = "scenarios/press_feed_run1.toml"
+def _wrappers() -> dict[str, FmuWrapper]:
+    """Every ``*_fmu.py`` script here, by the name of its ComponentSlave class."""
+    found: dict[str, FmuWrapper] = {}
+    for script in sorted(_HERE.glob("*_fmu.py")):
+        for node in ast.parse(script.read_text()).body:
+            if isinstance(node, ast.ClassDef) and any(
+                getattr(b, "id", None) == "ComponentSlave" for b in node.bases
+            ):
+                examples = _literal(node, "examples") or ()
+                found[node.name] = FmuWrapper(node.name, script, tuple(examples))
+    return found
 
 
-FMU_WRAPPERS: dict[str, FmuWrapper] = {
-    w.name: w
-    for w in (
-        _wrapper("Inertia", "inertia_fmu", _TWO_INERTIAS),
-        _wrapper(
-            "SpringDamperInertia",
-            "spring_damper_inertia_fmu",
-            _TWO_INERTIAS,
-        ),
-        _wrapper("GearTrain", "gear_train_fmu", _M739),
-        _wrapper(
-            "VergeEscapement",
-            "verge_escapement_fmu",
-            _M739,
-            _CLOCK_TRAIN,
-        ),
-        _wrapper(
-            "CrankCouplerDrive",
-            "crank_coupler_drive_fmu",
-            _PRESS_FEED,
-        ),
-        _wrapper("SpragClutch", "sprag_clutch_fmu", _PRESS_FEED),
-        _wrapper("BrakeLoad", "brake_load_fmu", _PRESS_FEED),
-        # The lever and mesh scenes run one FMU alone: nothing to couple.
-        _wrapper("DetachedLever", "detached_lever_fmu"),
-        _wrapper("GearMesh", "gear_mesh_fmu"),
-        _wrapper(
-            "ClockGearTrain",
-            "clock_gear_train_fmu",
-            _CLOCK_TRAIN,
-        ),
-    )
-}
+#: Model identifier -> wrapper, derived from the wrapper scripts (one class each).
+FMU_WRAPPERS: dict[str, FmuWrapper] = _wrappers()
