@@ -43,6 +43,9 @@ class CoupledSystem:
         self.scene = scene
         self.names = list(scene.master.order)
         self.index = {n: i for i, n in enumerate(self.names)}
+        #: what the orchestrator knows of each instance's FMU, in master order
+        self.models = [scene.fmus[n].model for n in self.names]
+        self.connections = scene.connections
         self.instances: list[FmuInstance] = []
         paths = {n: spec.path for n, spec in scene.fmus.items()} | (fmu_paths or {})
         try:
