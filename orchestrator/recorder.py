@@ -131,10 +131,10 @@ class RegimeLog:
     logged time is that communication point, not the switching instant.
     """
 
-    def __init__(self, system: Any, scene: Any, recorder: Recorder) -> None:
+    def __init__(self, system: Any, recorder: Recorder) -> None:
         self.system, self.recorder = system, recorder
         # Names of the regimes, from each FMU's Enumeration type (none: the numbers).
-        self.names = [scene.fmus[n].model.regime_names for n in system.names]
+        self.names = [model.regime_names for model in system.models]
         self.last = system.regimes()
 
     def update(self, t: float) -> int:

@@ -18,29 +18,21 @@ from components.base import Component
 from fmus.build import BuildError, build_fmu
 from fmus.registry import FMU_WRAPPERS
 from orchestrator.errors import ScenarioError
+from orchestrator.master_settings import (
+    ALGORITHMS,
+    COMMON_KEYS,
+    SETTING_KINDS,
+    MasterSettings,
+    SettingError,
+    master_settings,
+    read_options,
+)
 from orchestrator.model_info import ModelInfo, ModelInfoError, VariableInfo, model_info
 from orchestrator.scenes import ANALYSES, REFERENCES, family
 from orchestrator.scenes.family import Option
 from orchestrator.units import to_si
 
-ALGORITHMS = ("jacobi", "gauss-seidel", "regime-aware")
 REDUCTIONS = ("final", "initial", "max", "min", "maxabs", "mean")
-
-# Master settings: key -> (SI unit or None for a plain value, required?)
-_MASTER_KEYS: dict[str, tuple[str | None, bool]] = {
-    "algorithm": (None, True),
-    "step": ("s", True),
-    "order": (None, False),
-    "tolerance": ("1", False),
-    "event_tolerance": ("s", False),
-    "min_step": ("s", False),
-    "max_step": ("s", False),
-    "max_iterations": (None, False),
-    "max_events_per_step": (None, False),
-    "input_hold": ("choice", False),
-}
-# Master settings that take one of a few words.
-_MASTER_CHOICES: dict[str, tuple[str, ...]] = {"input_hold": ("start", "midpoint")}
 
 #: More macro steps than this cannot finish in any sensible time: refused unless forced.
 MAX_STEPS = 1e8
@@ -75,7 +67,8 @@ class MasterSpec:
     algorithm: str
     step: float
     order: tuple[str, ...]
-    options: dict[str, Any] = field(default_factory=dict)
+    options: dict[str, Any] = field(default_factory=dict)  # as the scene wrote them (SI)
+    settings: MasterSettings | None = None  # the algorithm's, defaults filled in
 
 
 @dataclass(frozen=True)
@@ -547,9 +540,9 @@ class _Loader:
             )
 
     def master(self, node: dict[str, Any], fmus: dict[str, FmuSpec], duration: float) -> MasterSpec:
-        self.check_keys(node, "master", set(_MASTER_KEYS))
-        for k, (_, required) in _MASTER_KEYS.items():
-            if required and k not in node:
+        self.check_keys(node, "master", {*COMMON_KEYS, *SETTING_KINDS})
+        for k in ("algorithm", "step"):
+            if k not in node:
                 raise self.fail(f"master.{k}", "missing")
         algorithm = self.string(node, "algorithm", "master.algorithm")
         if algorithm not in ALGORITHMS:
@@ -574,31 +567,13 @@ class _Loader:
             and sorted(order) == sorted(fmus)
         ):
             raise self.fail("master.order", f"expected every instance once, from {sorted(fmus)}")
-        options: dict[str, Any] = {}
-        for k, (unit, _) in _MASTER_KEYS.items():
-            if k in ("algorithm", "step", "order") or k not in node:
-                continue
-            if unit == "choice":
-                choices = list(_MASTER_CHOICES[k])
-                if node[k] not in choices:
-                    raise self.fail(f"master.{k}", f"expected one of {choices}, got {node[k]!r}")
-                options[k] = node[k]
-            elif unit is None:
-                if not isinstance(node[k], int) or isinstance(node[k], bool) or node[k] < 1:
-                    raise self.fail(f"master.{k}", f"expected a positive integer, got {node[k]!r}")
-                options[k] = node[k]
-            else:
-                value = self.quantity(node[k], f"master.{k}", unit)
-                if not value > 0.0:
-                    raise self.fail(f"master.{k}", f"must be positive, got {value}")
-                options[k] = value
-        low, high = options.get("min_step"), options.get("max_step")
-        if low is not None and high is not None and high < low:
-            raise self.fail(
-                "master.max_step", f"{high:g} s is less than master.min_step ({low:g} s)"
-            )
-        if algorithm == "regime-aware":
-            largest = options.get("max_step", 100.0 * step)
+        try:
+            options = read_options(node, self.quantity)
+            settings = master_settings(algorithm, step, duration, options)
+        except SettingError as exc:
+            raise self.fail(f"master.{exc.key}", str(exc)) from None
+        largest = getattr(settings, "max_step", None)
+        if largest is not None:
             if duration / largest > MAX_STEPS and not self.force:
                 raise self.fail(
                     "master.max_step" if "max_step" in options else "master.step",
@@ -606,7 +581,7 @@ class _Loader:
                     f"{duration / largest:.3g} macro steps, more than the limit "
                     f"{MAX_STEPS:.0e}: the run would not finish (--force to run it)",
                 )
-        return MasterSpec(algorithm, step, tuple(order), options)
+        return MasterSpec(algorithm, step, tuple(order), options, settings)
 
     def output(self, node: dict[str, Any], fmus: dict[str, FmuSpec], name: str):
         self.check_keys(node, "output", {"directory", "record", "every"})
@@ -785,10 +760,12 @@ class _Loader:
             if var is None or var.causality != causality:
                 raise self.fail(key, f"{fmus[instance].fmu} has no {causality} {name!r}")
             return var.unit or "1"
-        if len(parts) == 2 and parts[0] == "master" and parts[1] in _MASTER_KEYS:
-            if parts[1] in _MASTER_CHOICES:
+        if len(parts) == 2 and parts[0] == "master" and parts[1] in SETTING_KINDS:
+            if SETTING_KINDS[parts[1]].choices:
                 raise self.fail(key, f"cannot sweep {dotted!r}: it is a word, not a number")
-            return _MASTER_KEYS[parts[1]][0]
+            return SETTING_KINDS[parts[1]].unit
+        if len(parts) == 2 and parts[0] == "master" and parts[1] in COMMON_KEYS:
+            return "s" if parts[1] == "step" else None
         if len(parts) == 2 and parts[0] == "scene" and parts[1] in ("start", "stop"):
             return "s"
         raise self.fail(

@@ -43,6 +43,9 @@ class CoupledSystem:
         self.scene = scene
         self.names = list(scene.master.order)
         self.index = {n: i for i, n in enumerate(self.names)}
+        #: what the orchestrator knows of each instance's FMU, in master order
+        self.models = [scene.fmus[n].model for n in self.names]
+        self.connections = scene.connections
         self.instances: list[FmuInstance] = []
         paths = {n: spec.path for n, spec in scene.fmus.items()} | (fmu_paths or {})
         try:
@@ -85,6 +88,23 @@ class CoupledSystem:
         self.int_refs = [
             inst.refs(n) for inst, n in zip(self.instances, self.int_names, strict=True)
         ]
+        # Prepared transfers (hot path); None where there is nothing to transfer.
+        self._get_reals = [
+            inst.getter(refs) if refs else None
+            for inst, refs in zip(self.instances, self.real_refs, strict=True)
+        ]
+        self._get_ints = [
+            inst.getter(refs, integer=True) if refs else None
+            for inst, refs in zip(self.instances, self.int_refs, strict=True)
+        ]
+        self._set_reals = [
+            inst.setter(f.real_refs) if f.real_refs else None
+            for inst, f in zip(self.instances, self.feeds, strict=True)
+        ]
+        self._set_ints = [
+            inst.setter(f.int_refs, integer=True) if f.int_refs else None
+            for inst, f in zip(self.instances, self.feeds, strict=True)
+        ]
         self.values: list[list[float]] = [[] for _ in self.names]
         self.ints: list[list[int]] = [[] for _ in self.names]
         self.record_header = [f"{inst}.{var}" for inst, var in scene.record]
@@ -125,11 +145,12 @@ class CoupledSystem:
 
     # -- transfers (hot path) ---------------------------------------------------------
     def read(self, i: int) -> None:
-        inst = self.instances[i]
-        if self.real_refs[i]:
-            self.values[i] = inst.get_real(self.real_refs[i])
-        if self.int_refs[i]:
-            self.ints[i] = inst.get_integer(self.int_refs[i])
+        get = self._get_reals[i]
+        if get is not None:
+            self.values[i] = get()
+        get = self._get_ints[i]
+        if get is not None:
+            self.ints[i] = get()
 
     def read_all(self) -> None:
         for i in range(len(self.instances)):
@@ -139,14 +160,16 @@ class CoupledSystem:
         """Set instance i's inputs from the latest values read from its sources (its Real
         inputs from ``reals`` instead, when given, in the order of ``feeds[i]``)."""
         feed = self.feeds[i]
-        if feed.real_refs:
+        set_reals = self._set_reals[i]
+        if set_reals is not None:
             if reals is None:
                 values = self.values
                 reals = [values[s][k] for s, k in feed.real_sources]
-            self.instances[i].set_real(feed.real_refs, reals)
-        if feed.int_refs:
+            set_reals(reals)
+        set_ints = self._set_ints[i]
+        if set_ints is not None:
             ints = self.ints
-            self.instances[i].set_integer(feed.int_refs, [ints[s][k] for s, k in feed.int_sources])
+            set_ints([ints[s][k] for s, k in feed.int_sources])
 
     def step(self, i: int, t: float, h: float) -> None:
         self.instances[i].do_step(t, h)

@@ -1,7 +1,9 @@
-"""Master algorithms.  Each takes (system, scene, recorder, stats, progress) and runs the scene."""
+"""Master algorithms.  Each takes (system, scene, recorder, stats, progress) and runs the
+scene with the typed settings its [master] table was read into (orchestrator.master_settings)."""
 
 from __future__ import annotations
 
+from orchestrator.master_settings import TOLERANCE_MASTERS
 from orchestrator.masters.fixed_step import run_gauss_seidel, run_jacobi
 from orchestrator.masters.regime_aware import run_regime_aware
 
@@ -10,5 +12,4 @@ MASTERS = {
     "gauss-seidel": run_gauss_seidel,
     "regime-aware": run_regime_aware,
 }
-#: Masters whose accuracy is set by master.tolerance rather than by the macro step.
-TOLERANCE_MASTERS: tuple[str, ...] = ("regime-aware",)
+__all__ = ["MASTERS", "TOLERANCE_MASTERS"]

@@ -10,34 +10,37 @@ from __future__ import annotations
 
 import math
 
+from orchestrator.master_settings import FixedStepSettings
 from orchestrator.recorder import Recorder, RegimeLog, StepStats
 from orchestrator.scenario import Scene
 from orchestrator.system import CoupledSystem
 
 
-def _grid(scene: Scene) -> tuple[int, float]:
-    """Number of macro steps and the step; the last step is shortened to land on stop."""
-    h = scene.master.step
-    n = math.ceil((scene.stop - scene.start) / h - 1e-9)
-    return n, h
+def _grid(start: float, stop: float, h: float) -> int:
+    """Number of macro steps of h; the last step is shortened to land on stop."""
+    return math.ceil((stop - start) / h - 1e-9)
 
 
-def _run(
+def run_fixed_step(
     system: CoupledSystem,
-    scene: Scene,
+    h: float,
+    start: float,
+    stop: float,
+    record_every: int,
     recorder: Recorder,
     stats: StepStats,
     progress,
     sequential: bool,
 ) -> None:
-    n, h = _grid(scene)
+    """Macro steps of h from start to stop, a row recorded every ``record_every`` steps."""
+    n = _grid(start, stop, h)
     m = len(system.instances)
-    every = scene.record_every
-    recorder.row(system.record_row(scene.start))
-    log = RegimeLog(system, scene, recorder)
-    t = scene.start
+    every = record_every
+    recorder.row(system.record_row(start))
+    log = RegimeLog(system, recorder)
+    t = start
     for k in range(n):
-        hk = h if k < n - 1 else scene.stop - t
+        hk = h if k < n - 1 else stop - t
         if sequential:  # Gauss–Seidel: each FMU sees the newest outputs
             for i in range(m):
                 system.feed(i)
@@ -48,18 +51,33 @@ def _run(
                 system.feed(i)
                 system.step(i, t, hk)
             system.read_all()
-        t = scene.start + (k + 1) * h if k < n - 1 else scene.stop
+        t = start + (k + 1) * h if k < n - 1 else stop
         stats.steps += 1
         stats.do_steps += m
         stats.events += log.update(t)
-        stop = system.stop_indicator()
-        done = stop is not None and stop <= 0.0
+        stop_indicator = system.stop_indicator()
+        done = stop_indicator is not None and stop_indicator <= 0.0
         if (k + 1) % every == 0 or k == n - 1 or done:
             recorder.row(system.record_row(t))
         progress(t)
         if done:  # a fixed-step master stops at the first step past the condition
             stats.extra["stopped_by_condition"] = True
             return
+
+
+def _run(system, scene: Scene, recorder, stats, progress, sequential: bool) -> None:
+    settings: FixedStepSettings = scene.master.settings
+    run_fixed_step(
+        system,
+        settings.step,
+        scene.start,
+        scene.stop,
+        scene.record_every,
+        recorder,
+        stats,
+        progress,
+        sequential,
+    )
 
 
 def run_jacobi(

@@ -30,37 +30,11 @@ from dataclasses import dataclass
 from typing import Any
 
 from orchestrator.errors import RunError
-from orchestrator.masters.fixed_step import run_jacobi
+from orchestrator.master_settings import RegimeAwareSettings
+from orchestrator.masters.fixed_step import run_fixed_step
 from orchestrator.recorder import Recorder, RegimeLog, StepStats
 from orchestrator.scenario import Scene
 from orchestrator.system import CoupledSystem
-
-
-@dataclass(frozen=True)
-class Settings:
-    tolerance: float
-    event_tolerance: float
-    first_step: float
-    min_step: float
-    max_step: float
-    max_iterations: int  # exchange rounds at a switching instant
-    max_events_per_step: int  # switches allowed at (nearly) one instant before giving up
-    midpoint: bool  # corrector with held inputs at their step mean (else held at the start)
-
-    @classmethod
-    def of(cls, scene: Scene) -> Settings:
-        o = scene.master.options
-        h = scene.master.step
-        return cls(
-            tolerance=o.get("tolerance", 1e-4),
-            event_tolerance=o.get("event_tolerance", 1e-10),
-            first_step=h,
-            min_step=o.get("min_step", 1e-14),
-            max_step=o.get("max_step", min(100.0 * h, scene.stop - scene.start)),
-            max_iterations=o.get("max_iterations", 10),
-            max_events_per_step=o.get("max_events_per_step", 50),
-            midpoint=o.get("input_hold", "midpoint") == "midpoint",
-        )
 
 
 @dataclass
@@ -75,11 +49,20 @@ class _Snapshot:
 
 
 class RegimeAwareMaster:
-    def __init__(self, system: CoupledSystem, scene: Scene, recorder: Recorder, stats: StepStats):
-        self.system, self.scene, self.recorder, self.stats = system, scene, recorder, stats
-        self.cfg = Settings.of(scene)
+    def __init__(
+        self,
+        system: CoupledSystem,
+        settings: RegimeAwareSettings,
+        start: float,
+        stop: float,
+        recorder: Recorder,
+        stats: StepStats,
+    ):
+        self.system, self.recorder, self.stats = system, recorder, stats
+        self.cfg, self.control = settings, settings.control
+        self.start, self.stop = start, stop
         self.names = system.names
-        self.log = RegimeLog(system, scene, recorder)
+        self.log = RegimeLog(system, recorder)
         # Exchanged Real signals held over a step: (instance, slot) of their sources.  Inputs
         # that are sampled as a state at the step start carry no hold error of their own.
         # Midpoint hold: per instance, its Real inputs in feed order as (source, averaged?);
@@ -90,10 +73,10 @@ class RegimeAwareMaster:
         # order, as with input_hold = "start").
         held, blind = set(), set()
         self.held_inputs: list[list[tuple[tuple[int, int], bool]]] = [[] for _ in self.names]
-        for c, src in zip(scene.connections, system.connection_sources, strict=True):
+        for c, src in zip(system.connections, system.connection_sources, strict=True):
             if src is None:
                 continue
-            model = scene.fmus[c.target[0]].model
+            model = system.models[system.index[c.target[0]]]
             sampled = c.target[1] in model.sampled
             if not model.annotated:
                 blind.add(src)
@@ -106,8 +89,8 @@ class RegimeAwareMaster:
         self.scale = {s: 0.0 for s in self.signals}
         self.first_order = not self.cfg.midpoint  # the last error ratio's order in h
         black_boxes = sorted(
-            {c.target[0] for c in scene.connections}
-            & {n for n in self.names if not scene.fmus[n].model.annotated}
+            {c.target[0] for c in system.connections}
+            & {n for n, model in zip(self.names, system.models, strict=True) if not model.annotated}
         )
         if black_boxes and self.cfg.midpoint:
             stats.extra.setdefault("warnings", []).append(
@@ -207,7 +190,7 @@ class RegimeAwareMaster:
             fired = after_regimes[i] != before.regimes[i]
             if watch.t_event is not None:
                 te = system.values[i][watch.t_event]
-                if t < te <= t + h * (1 + 1e-12):
+                if t < te <= t + h * (1 + self.control.event_time_slack):
                     best = te if best is None else min(best, te)
                     continue
                 if fired and te == t:
@@ -270,12 +253,13 @@ class RegimeAwareMaster:
     # -- main loop --------------------------------------------------------------------
     def run(self, progress) -> None:
         cfg, system, stats, recorder = self.cfg, self.system, self.stats, self.recorder
-        t, stop = self.scene.start, self.scene.stop
+        control = self.control
+        t, stop = self.start, self.stop
         h = cfg.first_step
         target: float | None = None  # a switch seen in a rolled-back trial, not yet reached
         recorder.row(system.record_row(t))
         same_instant = 0
-        while t < stop - 1e-15 * max(1.0, abs(stop)):
+        while t < stop - control.stop_slack * max(1.0, abs(stop)):
             if target is not None and target <= t:
                 target = None
             h = min(h, stop - t)
@@ -295,8 +279,7 @@ class RegimeAwareMaster:
                 ratio = self.step_ratio(before)
                 stats.events += self.log_switches(t - h, before)  # switched at the start
                 recorder.row(system.record_row(t))
-                grow = 4.0 if ratio == 0.0 else min(4.0, max(0.2, self._factor(ratio)))
-                h = min(cfg.max_step, h * grow)
+                h = min(cfg.max_step, h * control.grow(ratio, self.first_order))
                 same_instant = 0
             else:
                 target = None
@@ -305,11 +288,12 @@ class RegimeAwareMaster:
                 stats.iterations += self.settle() - 1
                 stats.events += max(self.log_switches(t, before), 1)
                 recorder.row(system.record_row(t))  # values just after the switch
-                same_instant = same_instant + 1 if h <= 10 * cfg.event_tolerance else 0
+                window = control.settle_window * cfg.event_tolerance
+                same_instant = same_instant + 1 if h <= window else 0
                 if same_instant > cfg.max_events_per_step:
                     raise RunError(
                         f"chattering: {same_instant} switches within "
-                        f"{10 * cfg.event_tolerance:.1e} s of each other; "
+                        f"{window:.1e} s of each other; "
                         f"last in {self._last_switch()}",
                         t,
                     )
@@ -326,10 +310,10 @@ class RegimeAwareMaster:
         A signal that jumps without a reported event (its change does not shrink with the
         step) is a discontinuity: the step that contains it is accepted as a switch.
         """
-        cfg = self.cfg
+        cfg, control = self.cfg, self.control
         last_ratio = None
         stalled = 0
-        for _ in range(200):
+        for _ in range(control.max_trials):
             self.left_row = None  # set by _correct_landing for this very trial
             self.trial(t, h)
             te = self.switch_time(t, h, before)
@@ -345,7 +329,7 @@ class RegimeAwareMaster:
                         # The step onto the switch must pass the error test as well:
                         # approach it in shorter steps (the held-input error at an impact
                         # is the speed mismatch of the two sides, hence the energy).
-                        h = max(cfg.min_step, h * max(0.2, self._factor(ratio)))
+                        h = max(cfg.min_step, h * control.shrink(ratio, self.first_order))
                         self._rollback(state)
                         last_ratio = None
                         continue
@@ -359,16 +343,20 @@ class RegimeAwareMaster:
             if ratio > 1.0 and h > cfg.min_step:
                 # Two shrinks in a row that leave the change as large: a jump, not a smooth
                 # change (one shrink is not proof: a long step may span an oscillation).
-                stalled = stalled + 1 if last_ratio is not None and ratio > 0.5 * last_ratio else 0
-                if stalled >= 2:
+                as_large = last_ratio is not None and ratio > control.jump_ratio * last_ratio
+                stalled = stalled + 1 if as_large else 0
+                if stalled >= control.jump_shrinks:
                     self.stats.extra["jumps"] = self.stats.extra.get("jumps", 0) + 1
                     return h, t + h  # land after the jump and treat it as a switch
                 last_ratio = ratio
-                h = max(cfg.min_step, h * max(0.2, self._factor(ratio)))
+                h = max(cfg.min_step, h * control.shrink(ratio, self.first_order))
                 self._rollback(state)
                 continue
             return h, None
-        raise RunError(f"no acceptable step from here after 200 trials (last h = {h:.3e} s)", t)
+        raise RunError(
+            f"no acceptable step from here after {control.max_trials} trials (last h = {h:.3e} s)",
+            t,
+        )
 
     def _correct_landing(
         self, t: float, h: float, te: float, before: _Snapshot, state: list[Any]
@@ -396,11 +384,6 @@ class RegimeAwareMaster:
             self.left_row = None
         self.corrected_trial(t, h, before, state, predicted, compare=crossed)
         return self.switch_time(t, h, before)
-
-    def _factor(self, ratio: float) -> float:
-        """Step factor for an error ratio: the held-start error estimate is first order in
-        h; the predictor's error (midpoint hold) is second order in h over a step."""
-        return 0.9 / ratio if self.first_order else (0.8 / ratio) ** 0.5
 
     def _left_values(
         self, t: float, te: float, h: float, state: list[Any], before: _Snapshot
@@ -446,7 +429,7 @@ class RegimeAwareMaster:
 def run_regime_aware(
     system: CoupledSystem, scene: Scene, recorder: Recorder, stats: StepStats, progress
 ) -> None:
-    blind = [n for n in system.names if not scene.fmus[n].model.can_get_set_state]
+    blind = [n for n, m in zip(system.names, system.models, strict=True) if not m.can_get_set_state]
     if blind:
         # Without rollback no trial can be taken back: say what is given up, and couple
         # the way every tool can.
@@ -457,6 +440,19 @@ def run_regime_aware(
             f"master.step = {scene.master.step:g} s (no error control, switches seen only "
             "at communication points)"
         )
-        run_jacobi(system, scene, recorder, stats, progress)
+        run_fixed_step(
+            system,
+            scene.master.step,
+            scene.start,
+            scene.stop,
+            scene.record_every,
+            recorder,
+            stats,
+            progress,
+            sequential=False,
+        )
         return
-    RegimeAwareMaster(system, scene, recorder, stats).run(progress)
+    master = RegimeAwareMaster(
+        system, scene.master.settings, scene.start, scene.stop, recorder, stats
+    )
+    master.run(progress)

@@ -1,0 +1,174 @@
+"""Master settings: one typed dataclass per master, with its defaults and checks.
+
+A scene's ``[master]`` table is read into the settings of its algorithm here and nowhere
+else.  Every key a scene may write is a field of some master's settings, declared with
+``setting`` (its kind: an SI quantity, a positive count or one of a few words); the
+scenario loader only converts what the scene wrote into those kinds.  A key that another
+master uses is accepted and ignored (``--set master.algorithm=jacobi`` on a regime-aware
+scene keeps working).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+#: Keys every master has; the others are fields of the masters' settings.
+COMMON_KEYS = ("algorithm", "step", "order")
+
+
+class SettingError(ValueError):
+    """A master setting out of range: ``key`` (without ``master.``) and what is wrong."""
+
+    def __init__(self, key: str, message: str) -> None:
+        super().__init__(message)
+        self.key = key
+
+
+@dataclass(frozen=True)
+class SettingKind:
+    """How a scene writes a setting: a quantity in ``unit``, a count, or a word."""
+
+    unit: str | None = None  # SI unit of a quantity ("1" for a plain number)
+    choices: tuple[str, ...] = ()  # the words it takes
+
+    @property
+    def is_count(self) -> bool:
+        return self.unit is None and not self.choices
+
+
+def setting(default: Any, unit: str | None = None, choices: tuple[str, ...] = ()) -> Any:
+    """A field a scene may set as ``master.<name>`` (no unit and no choices: a count)."""
+    return field(default=default, metadata={"kind": SettingKind(unit, choices)})
+
+
+def _kinds(cls: type) -> dict[str, SettingKind]:
+    return {f.name: f.metadata["kind"] for f in dataclasses.fields(cls) if "kind" in f.metadata}
+
+
+@dataclass(frozen=True)
+class FixedStepSettings:
+    """Jacobi and Gauss–Seidel: one macro step, nothing else to set."""
+
+    step: float  # macro step [s]
+
+    @classmethod
+    def from_options(cls, step: float, duration: float, options: dict[str, Any]):
+        return cls(step)
+
+
+@dataclass(frozen=True)
+class StepControl:
+    """The regime-aware master's step-size controller: its constants, named."""
+
+    max_growth: float = 4.0  # largest factor a step grows by after an accepted one
+    max_shrink: float = 0.2  # smallest factor a rejected step shrinks by
+    safety_first_order: float = 0.9  # factor = safety / ratio for a first-order estimate
+    safety_second_order: float = 0.8  # factor = (safety / ratio) ** 0.5 for second order
+    max_trials: int = 200  # trials from one instant before the run is given up
+    jump_shrinks: int = 2  # shrinks in a row that leave the change as large: a jump
+    jump_ratio: float = 0.5  # "as large": the ratio fell by less than this factor
+    event_time_slack: float = 1e-12  # relative: a reported event time this past the end counts
+    stop_slack: float = 1e-15  # relative: a run this close to its stop time has reached it
+    settle_window: float = 10.0  # switches within this many event tolerances: one instant
+
+    def factor(self, ratio: float, first_order: bool) -> float:
+        """Step factor for an error ratio: the held-start estimate is first order in h,
+        the predictor's error (midpoint hold) second order."""
+        if first_order:
+            return self.safety_first_order / ratio
+        return (self.safety_second_order / ratio) ** 0.5
+
+    def shrink(self, ratio: float, first_order: bool) -> float:
+        """Factor for a rejected step (never below ``max_shrink``)."""
+        return max(self.max_shrink, self.factor(ratio, first_order))
+
+    def grow(self, ratio: float, first_order: bool) -> float:
+        """Factor for the step after an accepted one (between the two bounds)."""
+        if ratio == 0.0:
+            return self.max_growth
+        return min(self.max_growth, self.shrink(ratio, first_order))
+
+
+@dataclass(frozen=True)
+class RegimeAwareSettings:
+    """Error-controlled steps that land on every regime switch (masters/regime_aware.py)."""
+
+    first_step: float  # master.step: the first step and the step after a switch [s]
+    tolerance: float = setting(1e-4, "1")  # coupling error per step, relative to scale
+    event_tolerance: float = setting(1e-10, "s")  # how closely a step lands on a switch
+    min_step: float = setting(1e-14, "s")
+    max_step: float = setting(None, "s")  # default: 100 first steps, at most the run
+    max_iterations: int = setting(10)  # exchange rounds at a switching instant
+    max_events_per_step: int = setting(50)  # switches at (nearly) one instant: chattering
+    input_hold: str = setting("midpoint", choices=("start", "midpoint"))
+    control: StepControl = StepControl()
+
+    @property
+    def midpoint(self) -> bool:
+        """Corrector with held inputs at their step mean (else held at the step start)."""
+        return self.input_hold == "midpoint"
+
+    @classmethod
+    def from_options(cls, step: float, duration: float, options: dict[str, Any]):
+        """The settings of a scene: ``options`` as read_options gives them, the rest
+        defaults."""
+        values = {k: v for k, v in options.items() if k in _kinds(cls)}
+        values.setdefault("max_step", min(100.0 * step, duration))
+        return cls(first_step=step, **values)
+
+
+#: Every master's settings, by the name a scene gives its algorithm.
+SETTINGS: dict[str, type] = {
+    "jacobi": FixedStepSettings,
+    "gauss-seidel": FixedStepSettings,
+    "regime-aware": RegimeAwareSettings,
+}
+ALGORITHMS = tuple(SETTINGS)
+#: Masters whose accuracy is set by master.tolerance rather than by the macro step.
+TOLERANCE_MASTERS = tuple(a for a, cls in SETTINGS.items() if "tolerance" in _kinds(cls))
+#: Every key a scene's [master] table may hold beyond COMMON_KEYS, with its kind.
+SETTING_KINDS: dict[str, SettingKind] = {
+    k: v for cls in dict.fromkeys(SETTINGS.values()) for k, v in _kinds(cls).items()
+}
+
+MasterSettings = FixedStepSettings | RegimeAwareSettings
+
+
+def read_options(node: dict[str, Any], to_si: Callable[[Any, str, str], float]) -> dict[str, Any]:
+    """The settings a scene's [master] table writes, checked and in SI.
+
+    ``to_si(raw, key, unit)`` converts a quantity (and reports a bad one itself); a value
+    of the wrong kind or out of range raises SettingError.
+    """
+    options: dict[str, Any] = {}
+    for k, kind in SETTING_KINDS.items():
+        if k not in node:
+            continue
+        raw = node[k]
+        if kind.choices:
+            if raw not in kind.choices:
+                raise SettingError(k, f"expected one of {list(kind.choices)}, got {raw!r}")
+            options[k] = raw
+        elif kind.is_count:
+            if not isinstance(raw, int) or isinstance(raw, bool) or raw < 1:
+                raise SettingError(k, f"expected a positive integer, got {raw!r}")
+            options[k] = raw
+        else:
+            value = to_si(raw, f"master.{k}", kind.unit)
+            if not value > 0.0:
+                raise SettingError(k, f"must be positive, got {value}")
+            options[k] = value
+    low, high = options.get("min_step"), options.get("max_step")
+    if low is not None and high is not None and high < low:
+        raise SettingError("max_step", f"{high:g} s is less than master.min_step ({low:g} s)")
+    return options
+
+
+def master_settings(
+    algorithm: str, step: float, duration: float, options: dict[str, Any]
+) -> MasterSettings:
+    """The typed settings of ``algorithm`` (raises SettingError on a value out of range)."""
+    return SETTINGS[algorithm].from_options(step, duration, options)

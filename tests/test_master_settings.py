@@ -1,0 +1,75 @@
+"""Master settings: one typed dataclass per master, read from a scene's [master] table."""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+import pytest
+
+from orchestrator.errors import ScenarioError
+from orchestrator.master_settings import (
+    ALGORITHMS,
+    SETTING_KINDS,
+    SETTINGS,
+    FixedStepSettings,
+    RegimeAwareSettings,
+    StepControl,
+)
+from orchestrator.masters import MASTERS, TOLERANCE_MASTERS
+from orchestrator.scenario import load_scene
+
+SCENARIOS = Path(__file__).resolve().parent.parent / "scenarios"
+TWO = SCENARIOS / "two_inertias.toml"
+
+
+def test_every_master_has_settings_and_every_key_is_a_field() -> None:
+    assert set(ALGORITHMS) == set(MASTERS) == set(SETTINGS)
+    assert TOLERANCE_MASTERS == ("regime-aware",)
+    fields = {f.name for cls in SETTINGS.values() for f in dataclasses.fields(cls)}
+    assert set(SETTING_KINDS) <= fields
+    assert SETTING_KINDS["input_hold"].choices == ("start", "midpoint")
+    assert SETTING_KINDS["max_iterations"].is_count
+    assert SETTING_KINDS["event_tolerance"].unit == "s"
+
+
+def test_scene_settings_are_typed_with_defaults_filled_in() -> None:
+    scene = load_scene(TWO, {"master.algorithm": "regime-aware", "master.tolerance": 1e-3})
+    s = scene.master.settings
+    assert isinstance(s, RegimeAwareSettings)
+    assert s.tolerance == 1e-3
+    assert s.event_tolerance == 1e-10 and s.min_step == 1e-14
+    assert s.first_step == scene.master.step
+    assert s.max_step == min(100.0 * scene.master.step, scene.stop - scene.start)
+    assert s.midpoint and s.control == StepControl()
+    # A setting another master uses is accepted and ignored.
+    jacobi = load_scene(TWO, {"master.algorithm": "jacobi", "master.tolerance": 1e-3})
+    assert jacobi.master.settings == FixedStepSettings(jacobi.master.step)
+
+
+def test_step_control_factors() -> None:
+    c = StepControl()
+    assert c.grow(0.0, False) == c.max_growth
+    assert c.grow(1e-9, True) == c.max_growth
+    assert c.shrink(1e9, False) == c.max_shrink
+    assert c.grow(0.8, False) == pytest.approx(1.0)
+    assert c.shrink(0.9 * 2.0, True) == pytest.approx(0.5)
+
+
+@pytest.mark.parametrize(
+    ("overrides", "key", "fragment"),
+    [
+        ({"master.input_hold": "end"}, "master.input_hold", "expected one of"),
+        ({"master.max_iterations": 0}, "master.max_iterations", "positive integer"),
+        ({"master.tolerance": -1.0}, "master.tolerance", "must be positive"),
+        (
+            {"master.min_step": "1 ms", "master.max_step": "1 us"},
+            "master.max_step",
+            "less than master.min_step",
+        ),
+    ],
+)
+def test_bad_settings_name_the_key(overrides: dict, key: str, fragment: str) -> None:
+    with pytest.raises(ScenarioError) as info:
+        load_scene(TWO, {"master.algorithm": "regime-aware", **overrides})
+    assert f"[{key}]" in str(info.value) and fragment in str(info.value)
