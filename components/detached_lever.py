@@ -38,11 +38,10 @@ drive for the angle-switched model and the Table I units.
 from __future__ import annotations
 
 import math
-from typing import Any
 
 import numpy as np
 
-from .base import COMMON_OUTPUTS, Component, ComponentError, Variable
+from .base import COMMON_OUTPUTS, Component, ComponentError, SnapshotPlan, Variable
 from .detached_lever_data import (
     BALANCE_INERTIA,
     LIFT_ANGLE,
@@ -105,6 +104,7 @@ class DetachedLever(Component):
     """
 
     REGIME_NAMES = REGIME_NAMES
+    SNAPSHOT = SnapshotPlan()  # all its values are immutable scalars and tuples: shared
 
     VARIABLES = (
         Variable("inertia", "parameter", "kg.m2", _I0, "balance polar inertia I", min=0.0),
@@ -492,13 +492,6 @@ class DetachedLever(Component):
     def advance_to_next_beat(self, t: float, t_limit: float) -> float:
         """Advance to the next extreme (or t_limit); returns the time reached."""
         return self._advance(t, t_limit, stop_at_beat=True)
-
-    def get_state(self) -> dict[str, Any]:
-        return dict(self.__dict__)  # all values are immutable scalars and tuples
-
-    def set_state(self, state: dict[str, Any]) -> None:
-        self.__dict__.clear()
-        self.__dict__.update(state)
 
 
 # ------------------------------------------------------------------------------------------

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from .base import Component
+from .base import Component, SnapshotPlan
 from .event_integration import advance, step_control
 
 #: Magnitudes below which the integration controls the state [phi, phi_d, W] absolutely:
@@ -84,6 +84,9 @@ class TrainComponent(Component):
 
     _PHYSICS: type
     _MODEL: type
+    # The snapshot copies the mutable mode and state; the constants (and the memo of
+    # mode-only coefficients) are immutable in use and shared, which keeps it cheap.
+    SNAPSHOT = SnapshotPlan(lists=("_y",), objects={"_phys": {}, "_model": {"p": "_phys"}})
 
     def _take_loads(self) -> None:
         """Copy the held inputs the model integrates with: the escapement as an affine
@@ -133,25 +136,3 @@ class TrainComponent(Component):
         if m.t_first_event >= 0.0:
             self.t_event = t + m.t_first_event
         self._outputs()
-
-    # The snapshot copies the mutable mode and state; the constants (and the memo of
-    # mode-only coefficients) are immutable in use and shared, which keeps it cheap.
-    def get_state(self) -> dict[str, Any]:
-        snap = dict(self.__dict__)
-        if "_phys" in snap:
-            snap["_y"] = list(self._y)
-            snap["_phys"] = dict(self._phys.__dict__)
-            snap["_model"] = {n: v for n, v in self._model.__dict__.items() if n != "p"}
-        return snap
-
-    def set_state(self, state: dict[str, Any]) -> None:
-        self.__dict__.clear()
-        self.__dict__.update(state)
-        if "_phys" in state:
-            self._y = list(state["_y"])
-            phys = self._PHYSICS.__new__(self._PHYSICS)
-            phys.__dict__.update(state["_phys"])
-            model = self._MODEL.__new__(self._MODEL)
-            model.__dict__.update(state["_model"])
-            model.p = phys
-            self._phys, self._model = phys, model

@@ -54,7 +54,7 @@ import math
 from collections.abc import Callable
 from typing import Any
 
-from .base import Component, ComponentError, Variable, common_outputs
+from .base import Component, ComponentError, SnapshotPlan, Variable, common_outputs
 from .escape_wheel import ESCAPE_WHEEL_PORT
 from .event_integration import INTEGRATION_VARIABLES, advance, step_control
 from .m739_data import M739, M739Data
@@ -755,6 +755,10 @@ class VergeEscapement(Component):
     and decides a start from rest on the static reaction.
     """
 
+    # Cheap snapshot: the verge constants are immutable in use and shared; the regime
+    # machine's mode, the held train response and the state vector are copied.
+    SNAPSHOT = SnapshotPlan(lists=("_y",), objects={"_held": {}, "_core": {"train": "_held"}})
+
     REGIME_NAMES = REGIME_NAMES
     PORTS = {"escape_wheel": ESCAPE_WHEEL_PORT}
 
@@ -1018,28 +1022,6 @@ class VergeEscapement(Component):
             y = core.event(y, hit[0], 0.0)
             self._g_end = core.indicators(y)
         return y
-
-    # Cheap snapshot: the verge constants are immutable in use and shared; the regime
-    # machine's mode, the held train response and the state vector are copied.
-    def get_state(self) -> dict[str, Any]:
-        snap = dict(self.__dict__)
-        if "_core" in snap:
-            snap["_y"] = list(self._y)
-            snap["_held"] = dict(self._held.__dict__)
-            snap["_core"] = {n: v for n, v in self._core.__dict__.items() if n != "train"}
-        return snap
-
-    def set_state(self, state: dict[str, Any]) -> None:
-        self.__dict__.clear()
-        self.__dict__.update(state)
-        if "_core" in state:
-            self._y = list(state["_y"])
-            held = HeldTrain.__new__(HeldTrain)
-            held.__dict__.update(state["_held"])
-            core = VergeCore.__new__(VergeCore)
-            core.__dict__.update(state["_core"])
-            core.train = held
-            self._held, self._core = held, core
 
     def _outputs(self, y: list[float]) -> None:
         core = self._core
