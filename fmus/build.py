@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import ast
 import hashlib
-import importlib
 import os
 import re
 import shutil
@@ -170,7 +169,7 @@ def _build(wrapper: FmuWrapper, digest: str, tmp: Path) -> Path:
     (stage / "requirements.txt").write_text("".join(f"{line}\n" for line in needs))
     docs = tmp / "documentation"
     docs.mkdir()
-    component_class = _component_class(wrapper)
+    component_class = wrapper.component_class()
     (docs / "index.html").write_text(render_documentation(wrapper, component_class, needs))
     modules_before = set(sys.modules)
     try:
@@ -190,11 +189,6 @@ def _build(wrapper: FmuWrapper, digest: str, tmp: Path) -> Path:
             sys.path.remove(str(stage))
     _rewrite_description(Path(built), component_class)
     return Path(built)
-
-
-def _component_class(wrapper: FmuWrapper) -> type[Component]:
-    module_name, class_name = wrapper.component.rsplit(".", 1)
-    return getattr(importlib.import_module(module_name), class_name)
 
 
 def _rewrite_description(fmu: Path, component_class: type[Component]) -> None:

@@ -7,7 +7,10 @@ from __future__ import annotations
 import ast
 from dataclasses import dataclass
 from functools import cached_property
+from importlib import import_module
 from pathlib import Path
+
+from components.base import Component
 
 _HERE = Path(__file__).resolve().parent
 
@@ -32,6 +35,11 @@ class FmuWrapper:
             ):
                 return f"components.{node.value.value}"
         raise ValueError(f"{self.script} names no component (component = 'module.Class')")
+
+    def component_class(self) -> type[Component]:
+        """The component class itself (imports its module)."""
+        module_name, class_name = self.component.rsplit(".", 1)
+        return getattr(import_module(module_name), class_name)
 
 
 def _literal(cls: ast.ClassDef, name: str) -> object:

@@ -7,7 +7,6 @@ names the file, the key and what was expected.  The schema is documented in
 
 from __future__ import annotations
 
-import importlib
 import math
 import tomllib
 from dataclasses import dataclass, field
@@ -137,8 +136,7 @@ class Scene:
 
 
 def component_class(fmu_name: str) -> type[Component]:
-    module_name, class_name = FMU_WRAPPERS[fmu_name].component.rsplit(".", 1)
-    return getattr(importlib.import_module(module_name), class_name)
+    return FMU_WRAPPERS[fmu_name].component_class()
 
 
 def load_scene(

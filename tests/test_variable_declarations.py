@@ -14,7 +14,6 @@ chosen to include those regimes.
 
 from __future__ import annotations
 
-import importlib
 import tomllib
 from collections.abc import Callable, Iterator
 from dataclasses import replace
@@ -32,8 +31,7 @@ COMPONENTS = sorted(FMU_WRAPPERS)
 
 
 def component_class(name: str) -> type[Component]:
-    module, _, cls = FMU_WRAPPERS[name].component.rpartition(".")
-    return getattr(importlib.import_module(module), cls)
+    return FMU_WRAPPERS[name].component_class()
 
 
 def within(var: Variable, value: float) -> bool:
