@@ -1,4 +1,10 @@
-"""Shared fixtures: one FMU cache per test session, results in temporary directories."""
+"""Shared fixtures: one FMU cache per test session, results in temporary directories.
+
+Tests are grouped by layer, one folder each, and marked with its name so that a layer can be
+selected: ``components`` (the physics in plain Python), ``fmus`` (the FMUs through fmpy and
+other tools), ``orchestrator`` (scene loading, masters, studies, SSP, reliability) and
+``scenes`` (whole scenes against their references and sources), e.g. ``pytest -m scenes``.
+"""
 
 from __future__ import annotations
 
@@ -21,3 +27,14 @@ def fmu_cache(tmp_path_factory: pytest.TempPathFactory) -> Path:
     path = tmp_path_factory.mktemp("fmu_cache")
     os.environ["MECHCOSIM_FMU_CACHE"] = str(path)
     return path
+
+
+LAYERS = ("components", "fmus", "orchestrator", "scenes")
+
+
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    """Mark each test with its layer, the folder it lives in."""
+    for item in items:
+        layer = item.path.parent.name
+        if layer in LAYERS:
+            item.add_marker(getattr(pytest.mark, layer))

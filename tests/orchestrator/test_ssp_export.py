@@ -20,7 +20,7 @@ from orchestrator.scenario import load_scene
 from orchestrator.ssp_export import SSD, export_ssp
 from orchestrator.ssp_import import load_ssp
 
-SCENARIOS = Path(__file__).resolve().parent.parent / "scenarios"
+SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
 SCENES = sorted(SCENARIOS.glob("*.toml")) + sorted((SCENARIOS / "stability").glob("*.toml"))
 
 

@@ -26,7 +26,7 @@ from components.base import Component, Variable
 from fmus.registry import FMU_WRAPPERS
 from orchestrator.units import to_si
 
-SCENARIOS = Path(__file__).resolve().parent.parent / "scenarios"
+SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
 COMPONENTS = sorted(FMU_WRAPPERS)
 
 

@@ -15,7 +15,7 @@ from orchestrator.run import run_scene
 from orchestrator.scenario import load_scene
 from orchestrator.scenes.two_inertias.report import two_inertias_exact
 
-SCENE = Path(__file__).resolve().parent.parent / "scenarios" / "two_inertias.toml"
+SCENE = Path(__file__).resolve().parents[2] / "scenarios" / "two_inertias.toml"
 
 
 def run(tmp_path, fmu_cache, **overrides):

@@ -9,7 +9,7 @@ import pytest
 from orchestrator.run import run_scene
 from orchestrator.scenario import load_scene
 
-SCENE = Path(__file__).resolve().parent.parent / "scenarios" / "two_inertias.toml"
+SCENE = Path(__file__).resolve().parents[2] / "scenarios" / "two_inertias.toml"
 STOP_AT_ONE_RADIAN = {"signal": "a.phi", "above": "1 rad"}
 
 

@@ -22,7 +22,7 @@ from hypothesis import strategies as st  # noqa: E402
 
 from orchestrator.cli import main  # noqa: E402
 
-PROJECT_DIR = Path(__file__).resolve().parent.parent
+PROJECT_DIR = Path(__file__).resolve().parents[2]
 EXAMPLES = sorted((PROJECT_DIR / "scenarios").glob("*.toml"))
 RAW = {p.name: tomllib.loads(p.read_text()) for p in EXAMPLES}
 # Scenes short enough to run a few milliseconds of in the default suite.

@@ -32,7 +32,7 @@ from orchestrator.scenes.clock_train.monolithic import (
 )
 from orchestrator.scenes.m739.monolithic import run_m739
 
-SCENARIOS = Path(__file__).resolve().parent.parent / "scenarios"
+SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
 SCENE = SCENARIOS / "clock_train_sa.toml"
 SWEEP_SCENE = SCENARIOS / "clock_train_cd_sweep.toml"
 # Positions over two escape-wheel turns, off the piece bounds (generic points).

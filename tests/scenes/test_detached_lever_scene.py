@@ -17,7 +17,7 @@ from orchestrator.run import RunResult, run_scene
 from orchestrator.scenario import load_scene
 from orchestrator.scenes.detached_lever.lever import lever_scene
 
-SCENARIOS = Path(__file__).resolve().parent.parent / "scenarios"
+SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
 DECAY = SCENARIOS / "lever_unit_decay.toml"
 DECAY_ANGLE = SCENARIOS / "lever_unit_decay_angle_switched.toml"
 RATE = SCENARIOS / "lever_rate_vs_load.toml"

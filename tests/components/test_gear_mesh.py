@@ -49,7 +49,7 @@ from orchestrator.run import run_scene
 from orchestrator.scenario import load_scene
 from orchestrator.scenes.gear_mesh.report import mesh_scene
 
-SCENARIOS = Path(__file__).resolve().parent.parent / "scenarios"
+SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
 Z = LEGACY_PI / 180.0  # the programs' degree factor
 APP_E = {"mesh": 2, "printed_run": 1}  # Table 6/15 as the 1981 program ran it
 LOAD = 0.113  # N.m

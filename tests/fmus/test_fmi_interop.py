@@ -163,7 +163,7 @@ def test_foreign_connection_units_are_checked(tmp_path, foreign) -> None:
 
 
 # -- scene errors found from the model description ----------------------------------------
-TWO = Path(__file__).resolve().parent.parent / "scenarios" / "two_inertias.toml"
+TWO = Path(__file__).resolve().parents[2] / "scenarios" / "two_inertias.toml"
 
 
 def test_rad_output_to_torque_input_is_refused() -> None:

@@ -1,9 +1,9 @@
 """FMI 2.0 co-simulation FMUs that were not built with pythonfmu, for testing the orchestrator.
 
-Tests import this module as ``import foreign_fmus``: there is no ``tests/__init__.py``, so
-pytest puts ``tests/`` on ``sys.path`` (rootdir-relative "prepend" import mode).
+Tests import this module as ``import foreign_fmus``: the test folders have no ``__init__.py``,
+so pytest puts ``tests/fmus/`` on ``sys.path`` (rootdir-relative "prepend" import mode).
 
-* ``build_torsion_body`` compiles ``tests/foreign/torsion_body.c`` (a body on a torsional
+* ``build_torsion_body`` compiles ``tests/fmus/foreign/torsion_body.c`` (a body on a torsional
   spring–damper, integrated with RK4 substeps) with the system C compiler and packs it with
   a model description written here.  Variables have Modelica-style dotted names
   (``body.J``, ``spring.k``, ``flange.phi``, ...) under ``variableNamingConvention=
@@ -217,7 +217,7 @@ def torsion_body_model_description(guid: str, can_get_set_state: bool) -> bytes:
         modelName=MODEL_IDENTIFIER,
         guid=guid,
         description="Body on a torsional spring-damper tied to another body's flange",
-        generationTool="hand-written C (tests/foreign/torsion_body.c)",
+        generationTool="hand-written C (tests/fmus/foreign/torsion_body.c)",
         variableNamingConvention="structured",
         numberOfEventIndicators="0",
     )

@@ -33,7 +33,7 @@ from orchestrator.scenes.press_feed.report import (
     run_regime_sequences,
 )
 
-SCENARIOS = Path(__file__).resolve().parent.parent / "scenarios"
+SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
 REGIME_AWARE = {"master.algorithm": "regime-aware", "master.step": "1 us", "master.tolerance": 1e-3}
 GRAZING = ("clutch", "engaged", "overrun")
 

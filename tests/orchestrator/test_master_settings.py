@@ -19,7 +19,7 @@ from orchestrator.master_settings import (
 from orchestrator.masters import MASTERS, TOLERANCE_MASTERS
 from orchestrator.scenario import load_scene
 
-SCENARIOS = Path(__file__).resolve().parent.parent / "scenarios"
+SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
 TWO = SCENARIOS / "two_inertias.toml"
 
 

@@ -12,7 +12,7 @@ from components.m739_data import LBF
 from orchestrator.run import run_scene
 from orchestrator.scenario import load_scene
 
-SCENE = Path(__file__).resolve().parent.parent / "scenarios" / "m739.toml"
+SCENE = Path(__file__).resolve().parents[2] / "scenarios" / "m739.toml"
 
 
 def run(tmp_path: Path, fmu_cache: Path, name: str, **overrides):

@@ -34,7 +34,7 @@ from orchestrator.scenes.press_feed.report import (
     sampled_events,
 )
 
-SCENARIOS = Path(__file__).resolve().parent.parent / "scenarios"
+SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
 SCENES = sorted(p.name for p in SCENARIOS.glob("press_feed_*.toml")) + sorted(
     p.name for p in SCENARIOS.glob("sprag_decay_*.toml")
 )

@@ -10,7 +10,7 @@ import pytest
 from orchestrator.studies.jobs import Job, run_jobs
 from orchestrator.studies.work_precision import START_HOLD, observed_order, work_precision
 
-SCENE = Path(__file__).resolve().parent.parent / "scenarios" / "two_inertias.toml"
+SCENE = Path(__file__).resolve().parents[2] / "scenarios" / "two_inertias.toml"
 
 
 def jobs(tmp_path: Path, tag: str) -> list[Job]:

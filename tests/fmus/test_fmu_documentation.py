@@ -15,7 +15,7 @@ from fmus.documentation import DocumentationError, docstring_html, render_docume
 from fmus.registry import FMU_WRAPPERS
 from orchestrator.scenario import component_class
 
-PROJECT_DIR = Path(__file__).resolve().parent.parent
+PROJECT_DIR = Path(__file__).resolve().parents[2]
 
 NAMES = sorted(FMU_WRAPPERS)
 REQUIREMENTS = ["numpy>=1.26", "scipy>=1.11"]

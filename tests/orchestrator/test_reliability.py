@@ -26,7 +26,7 @@ from orchestrator.scenario import load_scene
 from orchestrator.scenes.family import Reference
 from orchestrator.system import CoupledSystem
 
-PROJECT_DIR = Path(__file__).resolve().parent.parent
+PROJECT_DIR = Path(__file__).resolve().parents[2]
 SCENARIOS = PROJECT_DIR / "scenarios"
 TWO = SCENARIOS / "two_inertias.toml"
 M739 = SCENARIOS / "m739.toml"

@@ -11,7 +11,7 @@ from orchestrator.errors import ScenarioError
 from orchestrator.scenario import load_scene
 from orchestrator.studies.parameter_sweep import run_sweep
 
-SCENE = (Path(__file__).resolve().parent.parent / "scenarios" / "two_inertias.toml").read_text()
+SCENE = (Path(__file__).resolve().parents[2] / "scenarios" / "two_inertias.toml").read_text()
 SWEEP = """
 [sweep]
 parameter = "fmus.b.parameters.k"

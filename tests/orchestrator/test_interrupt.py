@@ -20,7 +20,7 @@ import pytest
 from orchestrator.interrupt import Interrupted, SignalGuard, catching_signals
 from orchestrator.output_lock import LOCK_NAME
 
-PROJECT_DIR = Path(__file__).resolve().parent.parent
+PROJECT_DIR = Path(__file__).resolve().parents[2]
 M739 = PROJECT_DIR / "scenarios" / "m739.toml"
 
 
