@@ -16,6 +16,9 @@ from fmus.build import build_fmu
 from orchestrator.fmu_instance import FmuInstance
 from orchestrator.run import run_scene
 from orchestrator.scenario import load_scene
+from orchestrator.scenes.clock_train.monolithic import run_clock_train
+from orchestrator.scenes.m739.monolithic import run_m739
+from orchestrator.studies.parameter_sweep import run_sweep
 
 SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
 
@@ -107,8 +110,6 @@ def m739(budget: float = 300.0) -> None:
     halved from 1 us until its error reaches the regime-aware master's or ``budget``
     seconds of Jacobi runs are spent (then the time is extrapolated at the observed order).
     """
-    from orchestrator.scenes.m739.monolithic import run_m739
-
     out = Path("runs") / "bench_m739"
     t0 = time.perf_counter()
     truth = run_m739(tolerance=1e-12)
@@ -195,8 +196,6 @@ def _sweep_throughput(scene_file: str = "lever_rate_vs_load.toml") -> list[tuple
     """Throughput of a parameter sweep on 2 workers against 1: process pool and Dask."""
     from dask.distributed import LocalCluster
 
-    from orchestrator.studies.parameter_sweep import run_sweep
-
     out = Path("runs") / "bench_speed_sweep"
     walls: dict[tuple[str, int], float] = {}
     tables = []
@@ -246,9 +245,6 @@ def speed() -> None:
     Truths: the monolithic models at tolerance 1e-12.  The monolithic time is that of the
     loosest tolerance whose turns error is within the same budget as the co-simulation's.
     """
-    from orchestrator.scenes.clock_train.monolithic import run_clock_train
-    from orchestrator.scenes.m739.monolithic import run_m739
-
     rows: list[tuple[str, float, str]] = []
     for name, run, scene_file in (
         ("M739", run_m739, "m739.toml"),

@@ -16,6 +16,7 @@ from typing import Any
 
 import numpy as np
 
+from orchestrator.run import run_scene
 from orchestrator.scenario import load_scene
 
 
@@ -41,8 +42,6 @@ class JobResult:
 
 def run_job(job: Job) -> JobResult:
     """Run one job (in whatever process it lands in)."""
-    from orchestrator.run import run_scene
-
     scene = load_scene(job.scene, job.overrides)
     result = run_scene(scene, output_dir=Path(job.output_dir), show_progress=False)
     return JobResult(
