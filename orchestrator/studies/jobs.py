@@ -26,6 +26,9 @@ class Job:
     overrides: dict[str, Any]
     output_dir: str
     label: str = ""
+    #: compare with the scene's reference inside the run; a study that shares one
+    #: reference among its jobs computes it once itself and says False
+    compare_reference: bool = True
 
 
 @dataclass
@@ -43,7 +46,12 @@ class JobResult:
 def run_job(job: Job) -> JobResult:
     """Run one job (in whatever process it lands in)."""
     scene = load_scene(job.scene, job.overrides)
-    result = run_scene(scene, output_dir=Path(job.output_dir), show_progress=False)
+    result = run_scene(
+        scene,
+        output_dir=Path(job.output_dir),
+        show_progress=False,
+        compare_reference=job.compare_reference,
+    )
     return JobResult(
         job,
         result.status,
