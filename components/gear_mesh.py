@@ -1,8 +1,8 @@
 """One gear pair driven at a set speed against a load torque, with the mesh friction losses.
 
-Quasi-static (note ``models/mesh_efficiency.md`` §2.1): rigid teeth, no inertia.  The driver turns
-at the set speed, so its angle is exact, theta1 = theta1(t0) + omega (t - t0); the driven member
-follows the mesh kinematics, theta2 = f(theta1), with the instantaneous speed ratio
+Quasi-static (Tepper 1981, ARLCD-TR-81020, App. B, eq. B18): rigid teeth, no inertia.  The driver
+turns at the set speed, so its angle is exact, theta1 = theta1(t0) + omega (t - t0); the driven
+member follows the mesh kinematics, theta2 = f(theta1), with the instantaneous speed ratio
 R = d theta2 / d theta1.  The load torque T_L on the driven member (an input: another FMU may
 supply it) is balanced through R and the point efficiency eps(theta1) of the contact in force:
 
@@ -182,7 +182,7 @@ class InvoluteModel(MeshModel):
         table = k + 4
         mesh = INVOLUTE_MESHES[table]
         alpha_fin = None
-        if printed_run and table in ALFIN_ANOMALY_TABLES:  # the 1981 program's ALFIN (note §5.3)
+        if printed_run and table in ALFIN_ANOMALY_TABLES:  # the 1981 program's ALFIN (Tables 15-21)
             alpha_fin = PRINTED_RUNS[table].alfin_deg * LEGACY_PI / 180.0
         self.geometry: InvoluteGeometry = involute_geometry(
             mesh, alpha_fin=alpha_fin, legacy=printed_run
