@@ -53,7 +53,7 @@ class _ClockMonolithic(VergeTrainMonolithic):
 
 def arming_phi(phys: ClockTrainPhysics, rotor_angle: float = ARMING_ROTOR_ANGLE) -> float:
     """Cumulative escape-wheel angle at which the rotor reaches rotor_angle (forward kinematics
-    of the train, note §4-5)."""
+    of the train, eqs. 1-87 of the clock train report)."""
     theta1 = phys.theta1_0 + (rotor_angle - phys.phi1c)
     return M739_TRAIN.escape_angle(theta1) - phys.psi0
 
