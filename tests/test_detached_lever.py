@@ -115,7 +115,7 @@ def test_graph_factor_end_values() -> None:
 
 
 def test_table_i_steady_amplitudes() -> None:
-    # [derived] Theta* of the K-only CUCs at Table I's (C/omega0, K) (p. 56)
+    # Derived: Theta* of the K-only CUCs at Table I's (C/omega0, K) (p. 56)
     expected = {1: [2.803, 4.165, 5.450], 2: [1.545, 2.596, 3.663], 3: [1.752, 2.874, 3.972],
                 4: [2.032, 3.573, 4.974], 5: [2.121, 4.140, 5.993]}  # fmt: skip
     for unit, vals in expected.items():
