@@ -141,7 +141,7 @@ def involute_geometry(
     rf = inner_form_radius(rb, rp, b, phi, 1e-6 * INCH if legacy else 0.0)
     undercut = (1.0 - b / rp) <= rasfact  # standard pitch radius (eqs. 37/38)
     cd = mesh.center_distance
-    op = math.acos((rg + rp) * math.cos(phi) / cd)  # eq. 41
+    op = math.acos((rg + rp) * math.cos(phi) / cd)  # eq. 45
     scale = cd / (rg + rp)
     tan_op = math.tan(op)
     big_ro, ro = mesh.gear_outside_radius, mesh.pinion_outside_radius
