@@ -1,4 +1,8 @@
-"""Roller shaft with the referred strip inertia and a dry-friction brake (note §1.5).
+"""Roller shaft with the referred strip inertia and a dry-friction brake.
+
+Xu (1993), *Contributions to the Theory of Machine Dynamics* (PhD thesis, CUNY), Part I §3e
+(p. 13) and Table 1 (p. 36): brake and strip-on-table friction lumped into one torque T_b on the
+roller shaft, which holds the shaft in Regimes 1, 3 and 4 (§3f, p. 14).
 
 The brake and table friction are one constant torque T_b (static = kinetic).  State machine:
 

@@ -1,9 +1,9 @@
 """M739 spin-driven rotor behind a two-pass clock gear train (1 DOF, escape-wheel angle).
 
-The rotor, inertias, eccentricity and spin of the M739 S&A (Lowen & Tepper 1982, note
-``models/sa_verge_escapement.md`` §1, data ``components.m739_data``) drive the escape wheel
-through the two clock meshes of ``components.clock_train_kinematics.M739_TRAIN`` (note
-``models/clock_train_kinematics.md``) instead of the M739's involute train.
+The rotor, inertias, eccentricity and spin of the M739 S&A (Lowen & Tepper 1982, ARLCD-TR-82013,
+App. B and Input Data, pp. 7-11; data ``components.m739_data``) drive the escape wheel through
+the two clock meshes of ``components.clock_train_kinematics.M739_TRAIN`` (kinematics of the
+US Army fuze report of about 1980, Task 2, eqs. 1–126) instead of the M739's involute train.
 
 Representative geometry (neither source gives a clock tooth form for the M739; the choice is
 the one documented in ``components.clock_train_kinematics``): the M739 tooth counts and centre
@@ -19,7 +19,8 @@ tooth geometry) is the M739's.
 Coordinate: phi, the cumulative escape-wheel angle (0 at the start, forward positive as in
 ``components.gear_train``); psi = mesh_phase + phi is the escape-wheel angle of the train's
 kinematics.  On a smooth piece (both meshes: one tooth pair k_i in one phase, RoR or RoF, one
-sliding direction) the inverse kinematics (note §6, §8) give the cluster and rotor angles
+sliding direction) the inverse kinematics (eqs. 88–126, chained over the cluster) give the
+cluster and rotor angles
 theta2(phi), theta1(phi) and the ratios r2 = d theta2/d phi, r1 = d theta1/d phi and their
 derivatives r2', r1' = K1 r2^2 + DER1 r2'.
 
@@ -36,9 +37,10 @@ T_ref = M1 r1 - (I1 r1 r1' + I2 r2 r2') phi_d^2 (Lagrange).  With friction (``lo
 
 * 0 ``none``: lossless meshes and pivots.
 * 1 ``point`` (default): the point efficiency of the clock-mesh contact statics of
-  ``components.mesh_efficiency`` (the model behind ``ClockMeshModel``, note mesh_efficiency.md
-  §2.5): normal force N along the contact normal, Coulomb force mu |N| along the sliding
-  direction, pivot friction mu rho |N| at both pivots, evaluated on the contact point and normal
+  ``components.mesh_efficiency`` (the model behind ``ClockMeshModel``, derived there with the
+  friction model of Tepper 1981, App. B): normal force N along the contact normal, Coulomb
+  force mu |N| along the sliding direction, pivot friction mu rho |N| at both pivots, evaluated
+  on the contact point and normal
   of this train's kinematics.  Per unit N the gear resists with m_g and the pinion is driven with
   m_p; iq = m_p / m_g and the point efficiency is e = iq / DER.  The sliding direction reverses
   at the pitch point (an event); the sign of N (sigma, the lagged sign of the computed mesh force)
@@ -51,18 +53,20 @@ of rotor, cluster 2 and escape wheel (M739 pivot radii), opposing the motion; ``
 drops them.  The pivot reaction is taken as the centrifugal load plus |N| (an upper bound of
 the vector sum, like the |Fx| + |Fy| model of ``gear_train``).  mu = 0 makes every loss vanish.
 
-Handover: where a mesh's next tooth pair touches (sensing equation, note §4.4) the ratios jump.
+Handover: where a mesh's next tooth pair touches (sensing equation, eqs. 41–45, 83–87) the
+ratios jump.
 The new contact is taken as a perfectly inelastic impact: the generalized speed is projected
 so that the momentum conjugate to the new constraint is kept,
 phi_d+ = (I1 r1+ r1- + I2 r2+ r2- + I3 + J_load) phi_d- / (I1 r1+^2 + I2 r2+^2 + I3 + J_load),
 J_load being the inertia rigidly riding on the escape wheel at that instant (the verge while
 coupled, input ``J_load``).  The kinetic energy lost is booked as dissipated work.  RoR <-> RoF
-changes are C1 (note §4.3 consistency relation) and need no jump.
+changes are C1 (the derived pinion-form consistency relation) and need no jump.
 
 Energy: stored = 1/2 J_stot phi_d^2 with J_stot = I3 + I2 r2^2 + I1 r1^2, external = work of
 the spin on the rotor, A35 (cos Phi - cos Phi_0); dissipated = integral of the power balance
 plus the handover losses.  Not modelled: backlash (the meshes are bilateral), a return to RoR
-on exit (note §10 item 1), friction during the handover impact, the Coriolis pivot terms.
+on exit (the report models only the entry onto the flank), friction during the handover impact,
+the Coriolis pivot terms.
 """
 
 from __future__ import annotations

@@ -1,33 +1,41 @@
-"""Kinematics of both meshes of a two-pass clock gear train; note models/clock_train_kinematics.md.
+"""Kinematics of both meshes of a two-pass clock gear train.
+
+Source: the US Army fuze report of about 1980 (cover page lost) whose Task 1 gives test plans
+for the M577 SSD and M739 S&A escapement centre distance and whose Task 2 gives the forward and
+inverse kinematics of a two-pass clock train (eqs. 1–126, Figs. 1–4), after Lowen & Tepper,
+*Fuze Gear Train Analysis* (1979), App. G; "the clock train report" below.
 
 Rotor (gear 1) -> mesh 1 -> pinion 2 / gear 2 (one cluster) -> mesh 2 -> pinion 3 / escape wheel.
-Each mesh passes through two contact phases (note §1): round-on-round (RoR, the gear tip round on
-the pinion leaf round: a four-bar O_G-C_G-C_P-O_P, eqs. 8–22) and round-on-flank (RoF, the gear
-tip round on the radial pinion flank, eqs. 23–33), switching at the transition angle (eqs. 34–40).
-Every position equation has the form A sin x + B cos x = C (note §3.1); the root is taken as
-atan2(A, B) +- acos(C / sqrt(A^2 + B^2)), the sign fixed once by continuity with the transition.
+Each mesh passes through two contact phases (Task 2, Figs. 1–4): round-on-round (RoR, the gear
+tip round on the pinion leaf round: a four-bar O_G-C_G-C_P-O_P, eqs. 8–22) and round-on-flank
+(RoF, the gear tip round on the radial pinion flank, eqs. 23–33), switching at the transition
+angle (eqs. 34–40).  Every position equation has the form A sin x + B cos x = C (eqs. 15, 30, 38,
+57, 70, ...); the root is taken as atan2(A, B) +- acos(C / sqrt(A^2 + B^2)), the sign fixed once
+by continuity with the transition.
 
-Mesh 2 is the mirror image of mesh 1 (the sense of rotation is reversed; note §5.2): with
-phi1 = -phi2G, phi2P = -psi and beta1 = -beta2 the mesh-2 equations (53–82, 107–126) become the
-mesh-1 equations, so one set of formulas serves both.  The pinion tooth form obeys the
-consistency relation a_P = sqrt(f_P^2 + rho_P^2), delta_P = atan(rho_P / f_P) - alpha_P (note
-§4.3, derived there), which makes angle and speed ratio continuous at the RoR -> RoF change.
-Successive tooth pairs hand over where the sensing equation (41–45, 83–87) finds the next pair
-touching; angles are then carried over by the tooth spacings.
+Mesh 2 is the mirror image of mesh 1 (the sense of rotation is reversed; eqs. 46–87 carry the
+mirrored signs): with phi1 = -phi2G, phi2P = -psi and beta1 = -beta2 the mesh-2 equations
+(53–82, 107–126) become the mesh-1 equations, so one set of formulas serves both.  The pinion
+tooth form obeys the consistency relation a_P = sqrt(f_P^2 + rho_P^2),
+delta_P = atan(rho_P / f_P) - alpha_P (derived here, not in the report: the tip-round centre
+lies on the flank normal at f_P), which makes angle and speed ratio continuous at the
+RoR -> RoF change.  Successive tooth pairs hand over where the sensing equation (41–45, 83–87)
+finds the next pair touching; angles are then carried over by the tooth spacings.
 
-Representative M739-like geometry (the source gives none; note §7): the tooth counts and centre
-distances of the M739 train in Lowen & Tepper (1982, note sa_verge_escapement.md §6): rotor gear
-64 teeth on 0.4701 in to pinion 2 of 9 leaves, gear 2 of 36 teeth on 0.2327 in to pinion 3 of 8
-leaves, 32:1 overall.  The clock tooth form is chosen: gear tip-round centres on the pitch
-circles (a_G = R_G, so the mean ratio is -N_G/N_P), radial pinion flanks meeting the tip round
-at the pinion pitch radius (f_P = r_P), tip rounds rho_G = rho_P = 0.2 f_P, offsets delta_G = 0.1
-and alpha_P = 0.3 rad (phasing only), frame directions +-0.2 rad.  This keeps the note's verified
-synthetic shape (§9): each pair first touches round-on-round, passes to the flank, and hands over
-while on the flank, with the speed ratio within about 5 % of its mean.
+Representative M739-like geometry (the clock train report gives none): the tooth counts and
+centre distances of the M739 train in Lowen & Tepper (1982, ARLCD-TR-82013, Input Data,
+pp. 7-11): rotor gear 64 teeth on 0.4701 in to pinion 2 of 9 leaves, gear 2 of 36 teeth on
+0.2327 in to pinion 3 of 8 leaves, 32:1 overall.  The clock tooth form is chosen: gear tip-round
+centres on the pitch circles (a_G = R_G, so the mean ratio is -N_G/N_P), radial pinion flanks
+meeting the tip round at the pinion pitch radius (f_P = r_P), tip rounds rho_G = rho_P = 0.2 f_P,
+offsets delta_G = 0.1 and alpha_P = 0.3 rad (phasing only), frame directions +-0.2 rad.  This
+keeps the shape of a synthetic check geometry verified here against finite differences: each
+pair first touches round-on-round, passes to the flank, and hands over while on the flank, with
+the speed ratio within about 5 % of its mean.
 
-Task 1 of the source (test plans, §2) is given as data: ``TEST_PLANS`` and the escapement
-C.D. sweep ``M739_CD_SWEEP`` (nominal from the M739 input data of source 000; the tolerance band
-is in neither source and is assumed).  Angles in rad, lengths in m.
+Task 1 of the report (Test Plans 1 and 2) is given as data: ``TEST_PLANS`` and the escapement
+C.D. sweep ``M739_CD_SWEEP`` (nominal from the M739 input data of Lowen & Tepper 1982; the
+tolerance band is in neither source and is assumed).  Angles in rad, lengths in m.
 """
 
 from __future__ import annotations
@@ -45,7 +53,7 @@ PHASES = ("auto", "ror", "rof")
 
 
 def _solve(a: float, b: float, c: float, sign: float) -> float:
-    """Root of a sin x + b cos x = c (note §3.1), branch sign +-1."""
+    """Root of a sin x + b cos x = c (eq. 15 and its twins, in atan2 form), branch sign +-1."""
     r = math.hypot(a, b)
     if abs(c) > r:
         raise ValueError("no contact: A^2 + B^2 < C^2 (the pair cannot be assembled here)")
@@ -57,7 +65,8 @@ def _near(x: float, ref: float) -> float:
 
 
 def _derivatives(c: tuple[float, ...], x: float) -> tuple[float, float]:
-    """dx/du and d^2x/du^2 of the root x(u) of G = A sin x + B cos x - C(u) = 0 (note §6.0)."""
+    """dx/du and d^2x/du^2 of the root x(u) of G = A sin x + B cos x - C(u) = 0 (implicit
+    differentiation as in eqs. 94–97)."""
     a, b, _, da, db, dc, dda, ddb, ddc = c
     sx, cx = math.sin(x), math.cos(x)
     g_x = a * cx - b * sx
@@ -70,12 +79,12 @@ def _derivatives(c: tuple[float, ...], x: float) -> tuple[float, float]:
 
 @dataclass(frozen=True)
 class ClockMesh:
-    """One clock mesh, in the mesh-1 convention of the note (mirrored=True for mesh 2).
+    """One clock mesh, in the mesh-1 convention of eqs. 1–45 (mirrored=True for mesh 2).
 
     b, beta: centre distance and direction of O_gear -> O_pinion; a_g, delta_g, rho_g: gear
     tip-round centre distance, angular offset (direction phi - delta_g) and radius; alpha_p:
     flank direction offset (flank along phi_P + alpha_p); f_p: flank length to the tip round;
-    rho_p: pinion tip round.  n_gear, n_pinion set the tooth spacings (note §4.4).
+    rho_p: pinion tip round.  n_gear, n_pinion set the tooth spacings (eqs. 41–45).
     """
 
     b: float
@@ -91,7 +100,7 @@ class ClockMesh:
     mirrored: bool = False
     _cache: dict = field(default_factory=dict, compare=False, repr=False)
 
-    # -- derived pinion form (note §4.3 consistency relation) -----------------------------
+    # -- derived pinion form (consistency relation derived here) ---------------------------
     @property
     def a_p(self) -> float:
         return math.hypot(self.f_p, self.rho_p)
@@ -108,7 +117,7 @@ class ClockMesh:
     # -- position equations in the mesh-1 convention ---------------------------------------
     def _forward_abc(self, phi1: float, phase: str) -> tuple[float, ...]:
         """A, B, C of A sin phi2P + B cos phi2P = C (eqs. 11–14, 29) and their first and second
-        derivatives in phi1 (true derivatives, unlike the report's "D" names; note §10.4)."""
+        derivatives in phi1 (true derivatives, unlike the report's "D" names in eqs. 18–21)."""
         ag, b, be, dg, dp = self.a_g, self.b, self.beta1, self.delta_g, self.delta_p
         if phase == "ror":
             ap, ll = self.a_p, self.rho_g + self.rho_p
@@ -182,7 +191,8 @@ class ClockMesh:
         return self._cache["transition"]
 
     def _sign(self, kind: str, phase: str) -> float:
-        """Root sign giving the transition configuration (continuity, note §3.1)."""
+        """Root sign giving the transition configuration (by continuity; the report leaves it to
+        "geometric considerations")."""
         key = (kind, phase)
         if key not in self._cache:
             p1, p2 = self.transition()
@@ -220,7 +230,7 @@ class ClockMesh:
         ph = self._phase_inv(phi2p, phase)
         coeffs = self._inverse_def(phi2p, ph)
         v = _near(_solve(*coeffs[:3], self._sign("inv", ph)), self.transition()[0])
-        return (v, *_derivatives(coeffs, v))  # DER = X Y and X Z of note §6.0
+        return (v, *_derivatives(coeffs, v))  # DER = X Y and X Z (eqs. 95-97)
 
     # -- sensing and handover (eqs. 41–45) ---------------------------------------------------
     def sensing_gap(self, phi1: float) -> float:
@@ -261,7 +271,7 @@ class ClockMesh:
         return self._forward(phi_in, phase)[1]
 
     def ratio_derivative(self, phi_in: float, phase: str = "auto") -> float:
-        """d^2(output)/d(input)^2 [1/rad], for the acceleration terms of note §8."""
+        """d^2(output)/d(input)^2 [1/rad], for the acceleration terms (eqs. 97, 106, 116, 126)."""
         return self._forward(phi_in, phase)[2]
 
     def driver_angle(self, phi_out: float, phase: str = "auto") -> float:
@@ -269,11 +279,11 @@ class ClockMesh:
         return self._inverse(phi_out, phase)[0]
 
     def inverse_speed_ratio(self, phi_out: float, phase: str = "auto") -> float:
-        """d(input)/d(output), the report's DER (note §6)."""
+        """d(input)/d(output), the report's DER (eqs. 95, 104, 114, 124)."""
         return self._inverse(phi_out, phase)[1]
 
     def inverse_ratio_derivative(self, phi_out: float, phase: str = "auto") -> float:
-        """d^2(input)/d(output)^2 [1/rad], the report's X Z (note §6.0)."""
+        """d^2(input)/d(output)^2 [1/rad], the report's X Z (eqs. 97, 106, 116, 126)."""
         return self._inverse(phi_out, phase)[2]
 
     # -- smooth pieces, for dynamics with the output (pinion) angle as the coordinate ----------
@@ -281,7 +291,8 @@ class ClockMesh:
     # pinion angle x = s phi_out - k q (mesh-1 convention, q the pinion pitch) the pair's window
     # is (end, end + q]: RoR on (x_T, end + q], RoF on (end, x_T]; the gear turning forward
     # moves x down.  A dynamic model freezes the piece inside an integrator stage and moves to
-    # the next one at a located crossing of its bounds (note §10 item 1: RoR -> RoF -> handover).
+    # the next one at a located crossing of its bounds (RoR -> RoF -> handover; the report models
+    # only entry onto the flank, not a return to RoR).
     @property
     def window_end(self) -> float:
         """Local pinion angle x (mesh-1 convention) at which the pair hands over."""
@@ -395,12 +406,12 @@ class ClockTrain:
         return self.mesh1.driver_angle(self.mesh2.driver_angle(psi) - self.kappa2)
 
     def speed_ratio(self, phi1: float) -> float:
-        """d psi / d phi1 = R1 R2 (note §8)."""
+        """d psi / d phi1 = R1 R2 (chain rule over the cluster, phi2G' = phi2P', eq. 61)."""
         phi2p, r1, _ = self.mesh1._forward(phi1, "auto")
         return r1 * self.mesh2.speed_ratio(phi2p + self.kappa2)
 
     def ratio_derivative(self, phi1: float) -> float:
-        """d^2 psi / d phi1^2 = R2' R1^2 + R2 R1' (chain rule of note §8)."""
+        """d^2 psi / d phi1^2 = R2' R1^2 + R2 R1' (chain rule, derived here)."""
         phi2p, r1, d1 = self.mesh1._forward(phi1, "auto")
         _, r2, d2 = self.mesh2._forward(phi2p + self.kappa2, "auto")
         return d2 * r1 * r1 + r2 * d1
@@ -421,7 +432,7 @@ M739_TRAIN = ClockTrain(M739_MESH1, M739_MESH2)
 
 
 # ------------------------------------------------------------------------------------------
-# Task 1: test plans (note §2) as data
+# Task 1: Test Plans 1 (M577) and 2 (M739) of the clock train report, as data
 # ------------------------------------------------------------------------------------------
 TEST_PLANS: dict[str, dict] = {
     "M577": {
@@ -453,7 +464,7 @@ TEST_PLANS: dict[str, dict] = {
 
 
 def escapement_cd_sweep(nominal: float, tolerance: float, n: int = 9) -> np.ndarray:
-    """Escapement centre distances [m] across nominal +- tolerance, for sweeps SW-1/SW-2."""
+    """Escapement centre distances [m] across nominal +- tolerance, for the test plans' sweeps."""
     return nominal + tolerance * np.linspace(-1.0, 1.0, n)
 
 

@@ -1,6 +1,7 @@
 """Crank drive, RSSR linkage and elastic bent coupler: the rocker (outer race) motion.
 
-Physics (note §1.3, §2.2): the crank turns at constant speed; the coupler's first bending
+Physics of Xu (1993), *Contributions to the Theory of Machine Dynamics*, Part I §4-5 and App. B
+(pp. 15-23, 142-149): the crank turns at constant speed; the coupler's first bending
 mode q (inverted-cantilever space function, eqs 3-9) is the only elastic DOF and moves the
 rocker by ``phi4e = phi4r(phi1) + F2(phi1) q`` (14).  Eq. (B.15) with P2, P3 dropped:
 
@@ -40,7 +41,7 @@ REGIME_FORWARD = 1  # rocker on the feed stroke (theta4 increasing)
 REGIME_NAMES = {REGIME_RETURN: "return", REGIME_FORWARD: "forward"}
 
 
-# -- coupler properties (§1.3) -----------------------------------------------------------
+# -- coupler properties (Part I §4, Table 1) ----------------------------------------------
 def tube_section(c: BentCoupler) -> tuple[float, float]:
     """(area, second moment of area) of the tubular coupler."""
     area = math.pi / 4.0 * (c.d_outer**2 - c.d_inner**2)

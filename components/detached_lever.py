@@ -1,38 +1,42 @@
 """Detached lever escapement: balance wheel and hairspring driven by the train through the lever.
 
-Model of Monday (1965), note ``models/detached_lever.md``.  One degree of freedom, the balance angle
-theta, with
+Model of Monday (1965), *Detached Lever Clock Mechanism Dynamics* (PhD thesis, Oklahoma State
+University), Ch. III and App. A.  One degree of freedom, the balance angle theta, with
 
-    I theta'' + c theta' + k theta = T_coulomb + T_drive                       (note §2.2)
+    I theta'' + c theta' + k theta = T_coulomb + T_drive          (Monday 1965, App. A, p. 94)
 
 where the Coulomb torque has constant magnitude and opposes the motion and the drive torque acts
 only in short windows near the dead point: a resisting *unlock* torque and an aiding *impulse*
-torque (note §1.3, §2.4).  Within a window the right-hand side is constant, so every segment is a
-linear ODE solved in closed form (note §2.5) and the step needs no numerical integrator.
+torque (Monday 1965, Figs. 2 and 8, pp. 11 and 38; Ch. IV, pp. 39-45).  Within a window the
+right-hand side is constant, so every segment is a linear ODE solved in closed form (Monday 1965,
+Ch. III; App. A, pp. 94-102) and the step needs no numerical integrator.
 
 Two switching modes (``switching_mode``):
 
 * ``PHASE_SCHEDULED`` (0): the thesis model.  Windows are scheduled on the phase
   psi = omega1 (t - t_cycle) of the damped free oscillation, the Coulomb sign follows the nominal
-  phase, and each cycle lasts exactly 2 pi / omega1 (note §1.4, Table III).  This is the regression
+  phase, and each cycle lasts exactly 2 pi / omega1 (Monday 1965, Fig. 2, p. 11; Table III,
+  p. 112).  This is the regression
   reference: it reproduces the worked example and the computed unit curves.
 * ``ANGLE_SWITCHED`` (1): the physical model.  Unlock and impulse start and end when the balance
   angle crosses the escapement angles, in the direction the lever is waiting for; the Coulomb sign
   follows the actual speed and the balance sticks when the spring cannot overcome it.  Crossings
   are located exactly inside the step.  The period then depends on the drive torque (rate).
 
-Window angles (note §1.3): moving negative, unlock from +epsilon to +alpha, impulse from +alpha to
+Window angles (Monday 1965, Fig. 8, p. 38): moving negative, unlock from +epsilon to +alpha,
+impulse from +alpha to
 -beta; moving positive, unlock from -sigma to -gamma, impulse from -gamma to +mu.  After an
 impulse the lever passes to the other side (drop and lock are not modelled).
 
 The input is the torque the train applies at the escape wheel; the lever transmits it to the
 balance with the ratios ``impulse_ratio`` and ``unlock_ratio`` (balance torque per escape-wheel
 torque).  The defaults make the input the impulse torque at the balance and set the unlock torque
-to the fixture calibration 0.007155/0.06215 of it (note §1.1).
+to the fixture calibration 0.007155/0.06215 of it (Monday 1965, Ch. IV, pp. 39-45).
 
 The pure functions at the end give the per-cycle amplitude map of the phase-scheduled model
-(note §2.8), the computed unit curves, the graph factor, and steady amplitude and period against
-drive for the angle-switched model and the Table I units.
+(derived here from the Table III program: at the cycle end only its A terms survive, so the
+amplitude obeys an affine map), the computed unit curves, the graph factor, and steady amplitude
+and period against drive for the angle-switched model and the Table I units.
 """
 
 from __future__ import annotations
@@ -71,7 +75,7 @@ _I0 = BALANCE_INERTIA
 def _flow(
     x0: float, v0: float, tau: float, half_c: float, w1: float, w0sq: float
 ) -> tuple[float, float]:
-    """Exact solution of x'' + 2 half_c x' + w0sq x = 0 after time tau (note §2.5)."""
+    """Exact solution of x'' + 2 half_c x' + w0sq x = 0 after time tau (Monday 1965, App. A)."""
     e = math.exp(-half_c * tau)
     cs = math.cos(w1 * tau)
     sn = math.sin(w1 * tau) / w1
@@ -96,7 +100,7 @@ def _time_to_rest(x0: float, v0: float, half_c: float, w1: float, w0sq: float) -
 
 
 class DetachedLever(Component):
-    """Balance wheel and hairspring of a detached lever escapement (note §1–§2).
+    """Balance wheel and hairspring of a detached lever escapement (Monday 1965, Ch. III).
 
     regime: 0 free, 1 unlock, 2 impulse, 3 stopped (Coulomb sticking, angle-switched only).
     beat_count, amplitude and period follow the true extremes (speed zeros) in both modes;
@@ -255,7 +259,7 @@ class DetachedLever(Component):
         disc = self._w0sq - self._half_c**2
         if disc <= 0.0:
             raise ComponentError("DetachedLever: balance is not underdamped (C >= 2 omega0)")
-        self._w1 = math.sqrt(disc)  # note §2.5: omega1 = sqrt(4 omega0^2 - C^2)/2
+        self._w1 = math.sqrt(disc)  # Monday 1965, App. A: omega1 = sqrt(4 omega0^2 - C^2)/2
         self._mode = int(self.switching_mode)
         if self._mode not in (PHASE_SCHEDULED, ANGLE_SWITCHED):
             raise ComponentError(f"DetachedLever: unknown switching_mode {self._mode}")
@@ -266,7 +270,7 @@ class DetachedLever(Component):
             if e > _HALF_PI or s > _HALF_PI or b > _HALF_PI or m > _HALF_PI:
                 raise ComponentError("DetachedLever: phase windows must lie within a quarter")
             p = _HALF_PI
-            # (phase at segment end, Coulomb/motion sign d, drive kind), note §1.3 table.
+            # (phase at segment end, Coulomb/motion sign d, drive kind), Table III's ten steps.
             self._schedule = (
                 (p - e, -1, FREE),
                 (p - a, -1, UNLOCK),
@@ -307,7 +311,7 @@ class DetachedLever(Component):
 
     # -- forces -----------------------------------------------------------------------
     def _drive(self, regime: int, d: int) -> float:
-        """Lever torque on the balance for a window regime and motion sign d (note §2.2)."""
+        """Lever torque on the balance for a window regime and motion sign d (Monday, App. A)."""
         if regime == IMPULSE:
             return d * self.impulse_ratio * self.drive_torque
         if regime == UNLOCK:
@@ -495,7 +499,7 @@ class DetachedLever(Component):
 
 
 # ------------------------------------------------------------------------------------------
-# Phase-scheduled model as a per-cycle amplitude map (note §2.8; exact equivalent of Table III)
+# Phase-scheduled model as a per-cycle amplitude map (derived here; exact equivalent of Table III)
 # ------------------------------------------------------------------------------------------
 def phase_cycle_map(
     c: float,
@@ -555,7 +559,7 @@ def unit_curve(
 ) -> np.ndarray:
     """Computed unit curve (CUC): impulse-only drive X3/omega0^2 = K, released at 6.28 rad.
 
-    Returns the cycle-end amplitudes [rad] for cycles 0..n_cycles (note §3.1–3.2).  With
+    Returns the cycle-end amplitudes [rad] for cycles 0..n_cycles (Monday 1965, pp. 30-38).  With
     omega0 = 1 the cycle period is 2 pi / sqrt(1 - (C/omega0)^2/4) in units of 1/omega0.
     """
     return phase_amplitudes(
@@ -573,7 +577,7 @@ def unit_curve_steady(c_over_omega0: float, k: float, alpha: float = LIFT_ANGLE)
 
 
 def graph_factor(c_over_omega0: float, alpha: float = LIFT_ANGLE) -> float:
-    """K / B: impulse-only drive K that gives the same curve as Coulomb-only drive -B (§3.2)."""
+    """K / B: impulse-only drive K giving the curve of Coulomb-only drive -B (Monday, p. 37)."""
     _, per_k = phase_cycle_map(c_over_omega0, 1.0, 0.0, 0.0, 1.0, alpha=alpha, epsilon=alpha)
     _, per_b = phase_cycle_map(c_over_omega0, 1.0, -1.0, 0.0, 0.0, alpha=alpha, epsilon=alpha)
     return per_b / per_k
@@ -650,7 +654,7 @@ def table_i_params(unit: int, inertia: float = BALANCE_INERTIA) -> dict[str, flo
 
 
 def table_i_phase_steady(unit: int) -> list[float]:
-    """Steady amplitudes [rad] of the K-only CUCs matched to a unit's three loads (note §5.1)."""
+    """Steady amplitudes [rad] of the K-only CUCs matched to a unit's three loads (Table I)."""
     u = TABLE_I[unit]
     return [unit_curve_steady(u.c_over_omega0, row.k) for row in u.rows]
 
@@ -659,8 +663,9 @@ def table_i_phase_curve(unit: int, load_multiples: np.ndarray) -> tuple[np.ndarr
     """Steady amplitude [rad] and period [s] of the phase-scheduled model against load multiple.
 
     K is fitted linearly in load through the unit's three Table I values; the period is
-    2 pi / omega1 whatever the load (note §0.4), with omega1 from omega0 and C (the printed
-    omega1 of units 1 and 3 disagrees with them; note §5.1).
+    2 pi / omega1 whatever the load (the phase-scheduled forcing of Monday 1965, Fig. 2, fixes it),
+    with omega1 from omega0 and C (the printed omega1 of units 1 and 3 in Table I, p. 56, disagrees
+    with omega1 = sqrt(4 omega0^2 - C^2)/2).
     """
     u = TABLE_I[unit]
     slope, icpt = np.polyfit([r.load_multiple for r in u.rows], [r.k for r in u.rows], 1)
@@ -674,9 +679,11 @@ def table_i_angle_switched_fit(unit: int, inertia: float = BALANCE_INERTIA) -> t
     """(Coulomb torque [N.m], impulse torque per load multiple [N.m]) of the angle-switched
     model, fitted so that its steady amplitudes match the phase model's at the unit's loads.
 
-    The thesis's R and X belong to the phase-scheduled model and cannot be reused (note §1.4,
-    §8.1), so a load-independent Coulomb torque and a drive proportional to load are refitted by
-    least squares on the three steady amplitudes (C, omega0 and the angles are the unit's own).
+    The thesis's R and X belong to the phase-scheduled model and cannot be reused (derived here:
+    a phase window of half-width alpha delivers energy in proportion to the amplitude, an angle
+    window a fixed energy), so a load-independent Coulomb torque and a drive proportional to load
+    are refitted by least squares on the three steady amplitudes (C, omega0 and the angles are the
+    unit's own).
     The period is then a prediction of the angle-switched model.
     """
     from scipy.optimize import least_squares  # not at module level: the FMU packs numpy only
@@ -692,7 +699,7 @@ def table_i_angle_switched_fit(unit: int, inertia: float = BALANCE_INERTIA) -> t
         amps = [steady_state(p, abs(z[1]) * scale * m)[0] for m in loads]
         return np.array([3.0 if a != a else a - t for a, t in zip(amps, targets, strict=True)])
 
-    # start: viscous-only energy balance at the middle load, per half swing (note §2.8 spirit)
+    # start: viscous-only energy balance at the middle load, per half swing (as in the cycle map)
     a, e, cw = u.alpha, u.epsilon, u.c_over_omega0
     work_per_x = 2.0 * a - params["unlock_ratio"] * (e - a)
     x0 = 0.5 * math.pi * cw * targets[1] ** 2 / work_per_x / loads[1]

@@ -1,4 +1,4 @@
-"""Data of Monday (1965), *Detached Lever Clock Mechanism Dynamics*; note models/detached_lever.md.
+"""Data of Monday (1965), *Detached Lever Clock Mechanism Dynamics*, PhD thesis, Oklahoma State.
 
 The thesis works in inch, pound-force and second and states most quantities per unit balance
 inertia (torque / I, in s^-2), which are unit-free apart from the second.  Only the balance inertia
@@ -11,20 +11,22 @@ from dataclasses import dataclass
 
 from .units import LBF_IN
 
-#: Balance inertia of the worked example, 1.10e-7 lb.in.s^2 (note §4), in kg.m^2.
+#: Balance inertia of the worked example, 1.10e-7 lb.in.s^2 (Monday 1965, Ch. IV, pp. 39-45),
+#: in kg.m^2.
 BALANCE_INERTIA = 1.10e-7 * LBF_IN
 
-#: Power (lift) half-angle and start of unlock used by every program deck (note §3.2, App. B).
+#: Power (lift) half-angle and start of unlock used by every program deck (Monday 1965, p. 37;
+#: App. B, Tables II-IV data cards, pp. 109-115).
 LIFT_ANGLE = 0.2786896  # rad
 UNLOCK_START = 0.6337686  # rad
 
-#: Release amplitude of every unit curve: overbank, 6.28 rad (note §3.1).
+#: Release amplitude of every unit curve: overbank, 6.28 rad (Monday 1965, Ch. IV, p. 30).
 OVERBANK = 6.28
 
 
 @dataclass(frozen=True)
 class WorkedExample:
-    """Card deck of the Ch. IV estimation example (note §3.3), per unit inertia."""
+    """Card deck of the Ch. IV estimation example (Monday 1965, pp. 39-45), per unit inertia."""
 
     alpha: float = 0.2787  # rad, power angle before the line of centres (all four equal)
     epsilon: float = 0.6338  # rad, start of unlock (epsilon = sigma)
@@ -41,7 +43,7 @@ WORKED_EXAMPLE = WorkedExample()
 
 @dataclass(frozen=True)
 class TableIRow:
-    load_multiple: int  # fixture load in multiples of an unknown unit load (note §5.1)
+    load_multiple: int  # fixture load in multiples of an unknown unit load (from Table I X2, X3)
     r: float  # 1/s^2, Coulomb torque / I (chart-derived, numerically fragile)
     x_unlock: float  # 1/s^2
     x_impulse: float  # 1/s^2
@@ -61,7 +63,7 @@ class TableIUnit:
 
 
 # Table I, "Unit Curve Comparisons" (thesis p. 56).  Unit 4, row 1: X2 printed 232.530 is
-# taken as 236.530 (all X2 are integer multiples of ~236.535; note §5.1).
+# taken as 236.530 (derived here: every other X2 is an integer multiple of ~236.535).
 TABLE_I: dict[int, TableIUnit] = {
     1: TableIUnit(
         1, 15.707, 0.090, 15.90, 1.431, 0.633, 0.278,

@@ -1,8 +1,8 @@
 """One gear pair driven at a set speed against a load torque, with the mesh friction losses.
 
-Quasi-static (note ``models/mesh_efficiency.md`` §2.1): rigid teeth, no inertia.  The driver turns
-at the set speed, so its angle is exact, theta1 = theta1(t0) + omega (t - t0); the driven member
-follows the mesh kinematics, theta2 = f(theta1), with the instantaneous speed ratio
+Quasi-static (Tepper 1981, ARLCD-TR-81020, App. B, eq. B18): rigid teeth, no inertia.  The driver
+turns at the set speed, so its angle is exact, theta1 = theta1(t0) + omega (t - t0); the driven
+member follows the mesh kinematics, theta2 = f(theta1), with the instantaneous speed ratio
 R = d theta2 / d theta1.  The load torque T_L on the driven member (an input: another FMU may
 supply it) is balanced through R and the point efficiency eps(theta1) of the contact in force:
 
@@ -11,7 +11,7 @@ supply it) is balanced through R and the point efficiency eps(theta1) of the con
 Mesh models (parameter ``model``):
 
 0. ideal: the kinematics and contact phases of involute mesh ``mesh``, eps = 1;
-1. involute mesh ``mesh`` = k of source 001 (Table k + 4, k = 1..9; the Appendix E mesh is k = 2)
+1. involute mesh ``mesh`` = k of Tepper 1981 (Table k + 4, k = 1..9; the Appendix E mesh is k = 2)
    with friction ``mu`` at the teeth and both pivots: eqs. 46/47 (dual contact, equal load
    sharing) and A-26 (single contact), components.mesh_efficiency;
 2. clock mesh ``clock_mesh`` (1 or 2: M739_MESH1 / M739_MESH2 of
@@ -176,13 +176,13 @@ class MeshModel:
 
 
 class InvoluteModel(MeshModel):
-    """Involute mesh of source 001 (Tables 5–13 as published, driver as run)."""
+    """Involute mesh of Tepper 1981 (Tables 5–13 as published, driver as run)."""
 
     def __init__(self, k: int, mu: float, printed_run: bool, ideal: bool = False) -> None:
         table = k + 4
         mesh = INVOLUTE_MESHES[table]
         alpha_fin = None
-        if printed_run and table in ALFIN_ANOMALY_TABLES:  # the 1981 program's ALFIN (note §5.3)
+        if printed_run and table in ALFIN_ANOMALY_TABLES:  # the 1981 program's ALFIN (Tables 15-21)
             alpha_fin = PRINTED_RUNS[table].alfin_deg * LEGACY_PI / 180.0
         self.geometry: InvoluteGeometry = involute_geometry(
             mesh, alpha_fin=alpha_fin, legacy=printed_run
@@ -273,7 +273,7 @@ def build_mesh(model: int, mesh: int, clock_mesh: int, mu: float, printed_run: i
         if value != int(value) or int(value) not in allowed:
             raise ComponentError(
                 f"GearMesh: {name} must be one of {list(allowed)}, got {value!r}"
-                + (" (involute mesh k is Table k + 4 of source 001)" if name == "mesh" else "")
+                + (" (involute mesh k is Table k + 4 of Tepper 1981)" if name == "mesh" else "")
             )
         return int(value)
 
@@ -305,12 +305,12 @@ class GearMesh(Component):
     VARIABLES = (
         Variable(
             "model", "parameter", "1", MODEL_INVOLUTE,
-            "mesh model: 0 ideal, 1 involute mesh of source 001, 2 clock mesh (derived)",
+            "mesh model: 0 ideal, 1 involute mesh of Tepper 1981, 2 clock mesh (derived)",
             "Integer", min=MODEL_IDEAL, max=MODEL_CLOCK,
         ),
         Variable(
             "mesh", "parameter", "1", 2,
-            "involute mesh k = 1..9: Table k + 4 of source 001 (2: the Appendix E mesh)",
+            "involute mesh k = 1..9: Table k + 4 of Tepper 1981 (2: the Appendix E mesh)",
             "Integer", min=1, max=9,
         ),
         Variable(

@@ -3,7 +3,8 @@
 The report's data are in inch, lbf, second, lb.s^2/in and degrees; the US values are
 authoritative (the report's own SI conversions are about 0.16 % high).  Every number is
 written here once, in the source unit, and converted once with the factors below.
-Corrections of OCR typos follow the model note, section 6 / 10.2 item 11.
+Where the input echo of the App. A listing disagrees with the Input Data section (pp. 7-11) and
+the sample output, the latter win: PHID 139 deg, M1 0.3165e-4, RP2 0.05796 in, PHI1CD -120.134.
 """
 
 from __future__ import annotations

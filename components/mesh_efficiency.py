@@ -1,23 +1,27 @@
 """Instantaneous (point) and cycle efficiency of gear meshes with Coulomb friction.
 
-Model of Tepper (1981), note ``models/mesh_efficiency.md``: quasi-static rigid teeth, Coulomb
+Model of Tepper (1981), *Mesh Efficiency of the Integrated Safe/Arm Device of the Pershing II
+Missile System*, ARLCD-TR-81020 (pp. 1-13, App. B): quasi-static rigid teeth, Coulomb
 friction mu at the teeth and at both pivots, equal load sharing between two pairs in contact.
 
-Involute meshes (note §3): operating pressure angle for an extended centre distance (eqs. 39–45),
-pinion inner form radius (Shaffer, eq. 49), start and end of dual contact and contact ratio
-(eqs. 1–34), point efficiency in dual contact (eqs. 46/47 = B19/B20, corrected) and in single
-contact (ref. 1 eq. A-26), and the cycle efficiency as the mean of the K points (eqs. 51/52).
-The end of dual contact is computed by the physics, (sqrt(r_o^2 - r_b^2) - p_b)/r_b; the 1981
-program printed other values for four meshes (note §5.3), so it can be overridden to regress
-against Appendix E.
+Involute meshes (Tepper 1981, pp. 2-13, Figs. 7-9): operating pressure angle for an extended
+centre distance (eqs. 39–45), pinion inner form radius (Shaffer, eq. 49), start and end of dual
+contact and contact ratio (eqs. 1–34), point efficiency in dual contact (eqs. 46/47 = B19/B20,
+corrected) and in single contact (ref. 1 eq. A-26), and the cycle efficiency as the mean of the
+K points (eqs. 51/52).  The end of dual contact is computed by the physics,
+(sqrt(r_o^2 - r_b^2) - p_b)/r_b; the 1981 program printed other values for four meshes (ALFIN of
+Tables 15, 16, 18 and 21, pp. 31-37, disagrees with eqs. 20 + 23), so it can be overridden to
+regress against Appendix E.
 
-Clock meshes (note §2.5): the report gives no equations (CLOCK2 is in ref. 1).  The clock
+Clock meshes (Tepper 1981, p. 1, Fig. 2): the report gives no equations (CLOCK2 is in its
+ref. 1, Lowen & Tepper, *Fuze Gear Train Analysis*, ARLCD-TR-79030, 1979).  The clock
 efficiency here is **derived**: both working profiles are circular arcs (App. A constant-curvature
 teeth), continued below their centres of curvature by straight flanks.  In round-on-round contact
 the normal passes through both centres of curvature (a four-bar O_G-C_G-C_P-O_P); in round-on-flank
-contact it passes through the arc centre, square to the flank.  The general single-contact statics
-of note §2.5 (normal force, Coulomb force along the sliding direction, pivot friction mu rho |N|)
-then give the point efficiency; it reproduces ref. 1 eq. A-26 for an involute contact.  The pair in
+contact it passes through the arc centre, square to the flank.  The single-contact statics,
+derived here for any contact normal (normal force, Coulomb force along the sliding direction,
+pivot friction mu rho |N|, the friction model of Tepper 1981, App. B), then give the point
+efficiency; it reproduces ref. 1 eq. A-26 for an involute contact.  The pair in
 contact is the one that holds the driven pinion furthest back, which also hands over to the next
 pair.  The centre distance is not tabulated and is taken as R_G + R_P.
 
@@ -35,10 +39,12 @@ from scipy.optimize import brentq
 from .clock_train_kinematics import ClockMesh
 from .mesh_efficiency_data import INCH, ClockMeshData, InvoluteMesh
 
-#: The programs' truncated pi and degree factor (note §4); only for regression to the printout.
+#: The programs' truncated pi and degree factor (ISAD1/ISAD2, Tepper 1981, Apps. C-D, pp. 71-82);
+#: only for regression to the printout.
 LEGACY_PI = 3.14159
 
-#: Friction coefficients of the report's sweep (0 to 0.3 by 0.025, note §1).
+#: Friction coefficients of the report's sweep (0 to 0.3 by 0.025: the ISAD1/ISAD2 loop, Apps. C-D;
+#: the text on p. 2 says steps of 0.05).
 MU_SWEEP = tuple(0.025 * j for j in range(13))
 
 
@@ -85,7 +91,8 @@ def inner_form_radius(
 
     Undercut pinion: the sign change of Shaffer's TEST function (eq. 49), found by bracketing.
     Otherwise TEST only touches zero and the classical form radius
-    sqrt(r_b^2 + (r_p sin phi - b / sin phi)^2) is its touching point (note §3.3).
+    sqrt(r_b^2 + (r_p sin phi - b / sin phi)^2) is its touching point (derived here: the
+    classical no-undercut form radius, which the Shaffer root reproduces).
     grid > 0 rounds up to the programs' search grid r_b + n grid (INNERF: 1e-6 in), which the
     printed ALIN of the form-radius branch reflects.
     """
@@ -115,7 +122,7 @@ def involute_geometry(
     legacy: bool = False,
     rasfact: float = 0.883,
 ) -> InvoluteGeometry:
-    """Geometry and contact phases of an involute mesh (note §3.2–3.5).
+    """Geometry and contact phases of an involute mesh (Tepper 1981, eqs. 1-45, Figs. 7-8).
 
     driver: "pinion" (ISAD1) or "gear" (ISAD2); default, as the published run.
     alpha_fin: override of the end of dual contact [rad] (Appendix E used 13.948 deg).
@@ -132,9 +139,9 @@ def involute_geometry(
     pb = 2.0 * pi * rb / mesh.n_pinion
     b = (1.2 / mesh.diametral_pitch + 0.002) * INCH - mesh.hob_tip_radius * (1.0 - math.sin(phi))
     rf = inner_form_radius(rb, rp, b, phi, 1e-6 * INCH if legacy else 0.0)
-    undercut = (1.0 - b / rp) <= rasfact  # standard pitch radius (note §3.3)
+    undercut = (1.0 - b / rp) <= rasfact  # standard pitch radius (eqs. 37/38)
     cd = mesh.center_distance
-    op = math.acos((rg + rp) * math.cos(phi) / cd)  # eq. 41
+    op = math.acos((rg + rp) * math.cos(phi) / cd)  # eq. 45
     scale = cd / (rg + rp)
     tan_op = math.tan(op)
     big_ro, ro = mesh.gear_outside_radius, mesh.pinion_outside_radius
@@ -181,7 +188,8 @@ def involute_point_efficiency(geom: InvoluteGeometry, mu: float, alpha1: float) 
         a2 = a1 + geom.base_pitch
         s2 = _signum(alpha2, tan_op)
         s = s1 + s2
-        # pivot normal force over F_C: Q / (1 + mu^2), Q with mu^4 (note §3.6)
+        # pivot normal force over F_C: Q / (1 + mu^2) (App. B, B6-B13); mu^4 as the
+        # derivation gives, where the ISAD listings print mu^3
         q = math.sqrt(4.0 + mu * mu * (4.0 + s * s) + mu**4 * s * s) / (1.0 + mu * mu)
         num = 2.0 - mu * (s1 * (d - a1) + s2 * (d - a2)) / r2 - mu * rho2 * q / r2
         den = 2.0 - mu * (s1 * a1 + s2 * a2) / r1 + mu * rho1 * q / r1
@@ -225,7 +233,7 @@ def involute_sweep(
 
 
 # ------------------------------------------------------------------------------------------
-# General single-contact statics (note §2.5) and the derived clock round-on-round model
+# General single-contact statics (derived here) and the derived clock round-on-round model
 # ------------------------------------------------------------------------------------------
 def _cross(a: np.ndarray, b: np.ndarray) -> float:
     return float(a[0] * b[1] - a[1] * b[0])
@@ -246,7 +254,8 @@ def contact_efficiency(
     normal: unit normal of the force the driver exerts on the driven member.  The Coulomb
     force acts along the driver's sliding velocity relative to the driven surface; each pivot
     adds a resisting moment mu rho |N| (N the pivot normal reaction, which equals the contact
-    normal force for one contact; note §3.7).  Efficiency = output power / input power.
+    normal force for one contact, as in ref. 1 eq. A-26 of
+    Tepper 1981).  Efficiency = output power / input power.
     """
     r1, r2 = contact - o1, contact - o2
     ratio = _cross(r1, normal) / _cross(r2, normal)  # equal normal velocities
@@ -555,7 +564,7 @@ def train_mesh_efficiency(
 ) -> tuple[float, float]:
     """(point efficiency, speed ratio d pinion / d gear) at gear angle phi1 (mesh-1 convention).
 
-    The derived model of note §2.5 (the same statics as ClockMeshModel) on the kinematics of
+    The derived single-contact statics (the same as ClockMeshModel) on the kinematics of
     components.clock_train_kinematics: round-on-round, the normal through both round centres;
     round-on-flank, through the gear round's centre square to the radial flank.
     rho_*: pivot radii [m].

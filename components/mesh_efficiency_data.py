@@ -1,8 +1,9 @@
-"""Mesh data of Tepper (1981), ARLCD-TR-81020 (note: models/mesh_efficiency.md §5).
+"""Mesh data of Tepper (1981), ARLCD-TR-81020: Tables 1-22 (pp. 17-38) and Appendix E (p. 83).
 
 The report gives every length in inches; they are converted to metres here, once.  Outside radii
-are entered as the exact fractions (N + 2)/(2 Pd) that the 5-digit printed values round (note
-§5.2).  Pressure angles are in radians.
+are entered as the exact fractions (N + 2)/(2 Pd) that the 5-digit printed values round (derived
+here: every tabulated outside radius is (N + 2)/(2 Pd) to 5 digits, and Table 19's ALFIN
+reproduces only with the exact pinion radius).  Pressure angles are in radians.
 """
 
 from __future__ import annotations
@@ -91,7 +92,8 @@ PRINTED_RUNS: dict[int, PrintedRun] = {
     13: PrintedRun(0.1774, True, 20.21, 1.18, 14.068, 15.866),
 }
 
-#: Runs whose printed ALFIN disagrees with eq. 20 + 23 (ISAD1 form-radius branch, note §5.3).
+#: Runs whose printed ALFIN (Tables 15, 16, 18, 21, pp. 31-37) disagrees with eq. 20 + 23, as
+#: recomputed here (ISAD1 form-radius branch); keyed by input table.
 ALFIN_ANOMALY_TABLES = (6, 7, 8, 12)
 
 
@@ -160,5 +162,6 @@ APPENDIX_E_CYCLE = (.9660, .9336, .9029, .8736, None, None, .7940, .7699, .7469,
                     .6837)  # fmt: skip
 APPENDIX_E_MIN = (.9637, .9295, .8972, .8666, .8378, None, .7813, .7540, .7275, .7018, .6768,
                   .6526)  # fmt: skip
-#: The end of dual contact the 1981 run actually used for this mesh [deg] (note §5.3).
+#: The end of dual contact the 1981 run actually used for this mesh [deg] (Table 15, p. 31; the
+#: App. E point at 14.03 deg is already single contact).
 APPENDIX_E_ALFIN_DEG = 13.948

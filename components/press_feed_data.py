@@ -1,6 +1,8 @@
 """Data of the press roll feed of Xu (1993), converted once to SI.
 
-Source units are inch, lbf, second and radian (note ``models/press_feed_sprag.md`` §3).
+Xu (1993), *Contributions to the Theory of Machine Dynamics* (PhD thesis, CUNY): Table 1 (p. 36),
+Part I §7d-e (pp. 35-46), Tables 2-5 (pp. 82-105) and App. H (pp. 168-177).  Source units are
+inch, lbf, second and radian.
 Every constant below states its printed value and unit in the comment next to it; the
 conversion factors are the only place where inch/lbf appear.  Tests convert back with the
 same factors when they compare against printed numbers.
@@ -33,7 +35,7 @@ class RSSRLinkage:
 
 @dataclass(frozen=True)
 class BentCoupler:
-    """Bent tubular coupler of §1.3: two sections of length L at +-alpha to the chord AC."""
+    """Bent tubular coupler of Part I §4 (pp. 15-18): two sections of length L at +-alpha to AC."""
 
     length: float  # L, one section [m]
     alpha: float  # half bend angle [rad]
@@ -60,7 +62,8 @@ class FourierForcing:
 
 
 # -- Table 1: standard feed mechanism --------------------------------------------------------
-# a1 = 0.965 in as printed; App. H was evidently computed with a1 = 0.955 in (§10 item 1).
+# a1 = 0.965 in as printed; App. H was evidently computed with a1 = 0.955 in (derived: only
+# 0.955 in reproduces its phi4 = 101.07 deg at phi1 = 255.645 deg and its a31, b31).
 LINKAGE_TABLE1 = RSSRLinkage(
     a1=0.965 * IN, a3=32.523 * IN, a4=4.500 * IN, s1=1.156 * IN, s2=8.260 * IN, s3=31.410 * IN
 )
@@ -79,7 +82,7 @@ COUPLER_STANDARD = BentCoupler(
     youngs=30.0e6 * PSI,  # 30e6 lbf/in^2
     density=7.3e-4 * RHO_UNIT,  # 7.3e-4 lbf.s^2/in^4
     c_co=0.06 * LBF / IN**2,  # 0.06 lbf.s/in^2 (per unit length)
-    p1=2.65 * IN,  # 2.65 in, regime-2 average of P1 (§2.2)
+    p1=2.65 * IN,  # 2.65 in, regime-2 average of P1 (App. C b)
     gauge_x1=11.0 * IN,  # 11 in from A
 )
 # App. G: about 9.1 lb clamped at B for Run 3.
@@ -93,10 +96,11 @@ COUPLER_DAMPING_FACTOR = 0.45
 J_O4 = 0.1286 * LBF_IN
 # Clutch output shaft + roller without strip (Table 1): 0.114 lbf.in.s^2.
 J_O5_SHAFT = 0.114 * LBF_IN
-# Feed roller radius implied by the referred strip inertias (§1.5): 2.5 in.
+# Feed roller radius implied by the referred strip inertias of Part I §7e (derived: m r^2 of
+# the steel strips gives 0.298 and 0.703 lbf.in.s^2 with r = 2.5 in).
 ROLLER_RADIUS = 2.5 * IN
 
-# -- clutch (§1.4, Table 1, Part II) ---------------------------------------------------------
+# -- clutch (Part I eq. 1, Table 1, Part II) -------------------------------------------------
 K_SP = 2.0e5 * LBF_IN  # 2e5 lbf.in.rad^-3/2
 C_SP = 11.0 * LBF_IN  # 11.0 lbf.in.s, Part I linear damping fitted to Run 1
 C_NL = 62.6 * LBF_IN  # 62.6 lbf.in.s.rad^-5/4 (101)
@@ -107,7 +111,7 @@ J_PART2 = 0.815 * LBF_IN  # 0.815 lbf.in.s^2 (printed SI 0.092 N.m.s^2)
 
 @dataclass(frozen=True)
 class FeedRun:
-    """One run of Part I §7e (referred strip inertia from the printed values)."""
+    """One run of Part I §7e, pp. 37-46 (referred strip inertia from the printed values)."""
 
     name: str
     rpm: float
@@ -142,7 +146,8 @@ APP_H_SYSTEM = {"f1_hz": 36.765, "f2_hz": 82.166, "alpha1": 12.245, "alpha2": 36
 APP_H_PHI1_START_DEG = 255.645  # Table H-2
 
 # Table H end values (thesis sign, phi1 absolute, q in inch, q' in in/rad, windup in rad).
-# H-3 and H-9 q' read 0.0710 / 0.0721 (§10 item 5).
+# H-3 and H-9 q' read 0.0710 / 0.0721 (printed 0.710 / 0.721; the printed Regime 1 solution
+# gives 0.0713 there).
 APP_H_END_VALUES = {
     "R1_startup": {"phi1_deg": 271.114, "phi5_deg": 101.07, "q_in": 0.0105, "dq_in": 0.0710},
     "R2_startup": {
@@ -205,11 +210,11 @@ TABLE4 = SpragGeometry(
     youngs=30.0e6 * PSI,
     poisson=0.3,
     m_sprag=5.67e-5 * LB_PER_IN,  # 5.67e-5 lbf.s^2/in
-    j_sprag=8.71e-7 * LBF_IN,  # 8.71e-7 lbf.in.s^2 (printed unit garbled, §10 item 12)
+    j_sprag=8.71e-7 * LBF_IN,  # 8.71e-7 lbf.in.s^2 (Table 4 prints lb.s^2/in)
     j_inner=34.7e-4 * LBF_IN,  # Table 5: 34.7e-4 lbf.in.s^2
 )
 
-# -- Part II experiment (§5.5, Fig. 21-22) ---------------------------------------------------
+# -- Part II experiment (Part II §4, eqs. 92-104, Figs. 21-22, pp. 75-87) --------------------
 PART2_BRAKE_TORQUES = {
     72.0: tuple(v * LBF_IN for v in (52.0, 250.0, 370.0, 470.0)),
     197.0: tuple(v * LBF_IN for v in (85.0, 370.0, 600.0)),

@@ -1,4 +1,4 @@
-"""Rocker kinematics of the RSSR feed linkage (Appendix A, Hartenberg & Denavit).
+"""Rocker kinematics of the RSSR feed linkage (Xu 1993, App. A, pp. 134-141; Hartenberg & Denavit).
 
 All angles are in the thesis convention here (phi4 measured from Z0, *decreasing* on the
 feed stroke); the components turn them into forward-positive coordinates.  Derivatives are
@@ -23,7 +23,7 @@ class ExactRSSR:
     """Closed-form rigid rocker angle (A.8-A.9) and the elastic coupling F2 = 2 sin(alpha) eta4.
 
     ``f2_const`` (rad/m), when not None, replaces F2(phi1) by a constant (the thesis uses
-    0.098 rad/in in its linearized model, §2.2).
+    0.098 rad/in in its linearized model, App. C b).
     """
 
     def __init__(self, linkage: RSSRLinkage, alpha: float, f2_const: float | None = None) -> None:

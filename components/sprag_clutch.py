@@ -1,6 +1,7 @@
 """Sprag clutch between the outer race (rocker) and the inner race (roller shaft).
 
-Massless one-way coupling (note §1.4).  Windup ``w = theta4 - theta5`` (forward-positive
+Massless one-way coupling of Xu (1993), *Contributions to the Theory of Machine Dynamics*, Part I
+eq. (1), App. C, Part II §4 and Part III.  Windup ``w = theta4 - theta5`` (forward-positive
 coordinates; = phi5 - phi4 of the thesis).  While w > 0 the clutch is engaged and transmits
 
     T = max(0, K w^{3/2} + (c_lin + c_nl w^n) w')                (1), Part II (92)

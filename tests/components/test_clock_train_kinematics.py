@@ -1,4 +1,4 @@
-"""Clock train kinematics, note models/clock_train_kinematics.md §9 checks."""
+"""Clock train kinematics of the US Army fuze report of about 1980 (Task 2, eqs. 1-126): checks."""
 
 from __future__ import annotations
 
@@ -17,7 +17,8 @@ from components.clock_train_kinematics import (
     escapement_cd_sweep,
 )
 
-# The note's synthetic check geometry (§9): mesh 1 and a mirrored mesh 2 with beta2 = -0.3.
+# A synthetic check geometry (the report has no numbers; the values below are derived from an
+# independent implementation of its equations): mesh 1 and a mirrored mesh 2 with beta2 = -0.3.
 NOTE_M1 = ClockMesh(1.0, 0.2, 0.8, 0.1, 0.03, 0.3, 0.2, 0.03, 16, 4)
 NOTE_M2 = ClockMesh(1.0, -0.3, 0.8, 0.1, 0.03, 0.3, 0.2, 0.03, 16, 4, mirrored=True)
 MESHES = {"mesh1": M739_MESH1, "mesh2": M739_MESH2}
@@ -36,7 +37,7 @@ def test_note_transition_values() -> None:
 
 
 def test_note_second_derivatives() -> None:
-    """Note §9: d2phi2P/dphi1^2 jumps at the transition (-1.537 RoR, -3.037 RoF); X Z of the
+    """Derived: d2phi2P/dphi1^2 jumps at the transition (-1.537 RoR, -3.037 RoF); X Z of the
     mesh-1 RoR inverse at phi1 = 0.27 is -0.021089."""
     t = NOTE_M1.transition()[0]
     assert NOTE_M1.ratio_derivative(t, "ror") == pytest.approx(-1.537, abs=1e-3)
@@ -105,7 +106,7 @@ def test_handover_and_mean_ratio(name: str) -> None:
     mesh = MESHES[name]
     s = -1.0 if mesh.mirrored else 1.0
     h = s * mesh.handover()
-    # the next pair is sensed while the current pair is on the flank (note §9, test 4)
+    # the next pair is sensed while the current pair is on the flank (derived check)
     assert mesh.handover() > mesh.transition()[0]
     # angle continuous across the handover (the speed ratio may jump there)
     assert mesh.driven_angle(h - s * 1e-10) == pytest.approx(mesh.driven_angle(h), abs=1e-8)

@@ -1,4 +1,4 @@
-"""Detached lever escapement against Monday (1965), note models/detached_lever.md §7."""
+"""Detached lever escapement against Monday (1965), *Detached Lever Clock Mechanism Dynamics*."""
 
 from __future__ import annotations
 
@@ -34,7 +34,8 @@ WE_MAP = dict(
     alpha=WE.alpha, epsilon=WE.epsilon,
 )  # fmt: skip
 
-# Note §7 A: cycle-end amplitudes of the worked-example deck.
+# Cycle-end amplitudes of the worked-example deck (Monday 1965, pp. 39-45), derived: the thesis
+# prints none; these are its Table III algorithm (p. 112) run in double precision.
 WORKED_FIRST_TEN = [5.548613, 4.926520, 4.397389, 3.947328, 3.564521,
                     3.238919, 2.961973, 2.726412, 2.526052, 2.355632]  # fmt: skip
 
@@ -85,12 +86,12 @@ def test_phase_mode_step_size_independent() -> None:
 
 
 def test_unit_curves_and_scaling() -> None:
-    # K-only CUC at C/omega0 = 0.0515, K = 0.214 (note §7 A)
+    # K-only CUC at C/omega0 = 0.0515, K = 0.214 (derived: Table III algorithm)
     np.testing.assert_allclose(unit_curve(0.0515, 0.214, 5)[1:],
                                [5.559, 4.946, 4.424, 3.981, 3.603], atol=1e-3)  # fmt: skip
     assert unit_curve_steady(0.0515, 0.214) == pytest.approx(1.4556, abs=1e-4)
     assert unit_curve_steady(0.055, 0.214) == pytest.approx(1.3629, abs=1e-4)
-    # Theta*/K and r table (note §7 B)
+    # Theta*/K and r at the C/omega0 of App. C, Figs. 39-53 (derived: Table III algorithm)
     for cw, per_k, r in [(0.040, 8.757, 0.8819), (0.090, 3.893, 0.7535), (0.150, 2.336, 0.6234)]:
         assert unit_curve_steady(cw, 1.0) == pytest.approx(per_k, abs=1e-3)
         assert phase_cycle_map(cw, 1.0, 0, 0, 1.0, 0.2786896, 0.6337686)[0] == pytest.approx(
@@ -105,7 +106,7 @@ def test_unit_curves_and_scaling() -> None:
 def test_graph_factor(cw: float) -> None:
     gf = graph_factor(cw)
     assert gf == pytest.approx(3.650, rel=5e-3)  # the thesis's printed factor
-    assert 3.635 <= gf <= 3.640  # what the algorithm itself gives (note §7 B)
+    assert 3.635 <= gf <= 3.640  # what the Table III algorithm itself gives
 
 
 def test_graph_factor_end_values() -> None:
@@ -114,7 +115,7 @@ def test_graph_factor_end_values() -> None:
 
 
 def test_table_i_steady_amplitudes() -> None:
-    # [derived] Theta* of the K-only CUCs at Table I's (C/omega0, K), note §5.1
+    # Derived: Theta* of the K-only CUCs at Table I's (C/omega0, K) (p. 56)
     expected = {1: [2.803, 4.165, 5.450], 2: [1.545, 2.596, 3.663], 3: [1.752, 2.874, 3.972],
                 4: [2.032, 3.573, 4.974], 5: [2.121, 4.140, 5.993]}  # fmt: skip
     for unit, vals in expected.items():

@@ -1,5 +1,5 @@
-"""GearMesh (one gear pair at a set speed against a load) against Tepper (1981), note
-models/mesh_efficiency.md: the component alone, then its scenes through the orchestrator."""
+"""GearMesh (one gear pair at a set speed against a load) against Tepper (1981), ARLCD-TR-81020:
+the component alone, then its scenes through the orchestrator."""
 
 from __future__ import annotations
 
@@ -359,7 +359,7 @@ def test_scene_with_a_bad_mesh_number() -> None:
 @pytest.mark.slow
 def test_sweep_over_mu_and_the_nine_meshes(tmp_path: Path) -> None:
     """The [sweep] of mesh_efficiency.toml: each run's cycle and minimum efficiency against the
-    closed form, and the physical-ALFIN minima against the note's §9 K-point recomputation."""
+    closed form, and the physical-ALFIN minima against an independent K-point recomputation."""
     from orchestrator.studies.parameter_sweep import run_sweep
 
     res = run_sweep(SCENARIOS / "mesh_efficiency.toml", workers=2, output_dir=tmp_path)

@@ -1,7 +1,7 @@
 """M739 S&A physics (Lowen & Tepper 1982): geometry, algebra, split exactness, reference.
 
-Targets come from the report (ARLCD-TR-82013) as digested in
-``models/sa_verge_escapement.md`` §7-§10; forces are compared in lb, the report's unit.
+Targets come from the report (ARLCD-TR-82013): Output Data (pp. 11-13), the App. A sample output
+and Conclusions; forces are compared in lb, the report's unit.
 """
 
 from __future__ import annotations
@@ -64,7 +64,7 @@ def test_derived_data():
     assert tp.t2 / LBF == pytest.approx(10.246, rel=1e-4)
     assert tp.t3 / LBF == pytest.approx(8.0238, rel=1e-4)
     assert tp.a35 / TORQUE_US == pytest.approx(4.4982, rel=1e-4)
-    # Unity contact ratio meshes (§2.4).
+    # Unity contact ratio meshes (Input Data, pp. 7-11; subroutine ALFA, App. A).
     assert tp.al1_in == pytest.approx(0.36512, abs=2e-5)
     assert tp.al1_fin == pytest.approx(0.46323, abs=2e-5)
     assert tp.al2_in == pytest.approx(0.38774, abs=2e-5)
@@ -106,7 +106,7 @@ def _core_at(phi_t: float, phi_dot: float, phi_local: float, face: int, train: T
 
 
 def test_t0_algebra():
-    """The report's first printed row: s1 = s2 = s4 = s5 = +1 (§9)."""
+    """The report's first printed row (App. A sample output): s1 = s2 = s4 = s5 = +1."""
     train = TrainPhysics(M739)
     core, y = _core_at(0.0, 0.0, M739.phi_start, ENTRANCE, train)
     acc, _, _, _, pn, *_ = core.coupled_terms(y)
@@ -226,7 +226,7 @@ def test_free_train_matches_b193_b199():
 
 
 def test_free_verge_deceleration():
-    """B187 with r_cp = 0: constant pivot-friction deceleration (§4.5)."""
+    """B187 with r_cp = 0: constant pivot-friction deceleration (App. B)."""
     k = VergeConstants(M739, 0.1, 0.1, M739.omega, 0.0)
     core = VergeCore(k, HeldTrain(2.8e-9, 0.0, 1.0, M739.i_stot), 0.0, coupled=False)
     for s5, psi_d, target in ((1, 400.0, -7.63e5), (-1, -400.0, 6.96e5)):
@@ -295,7 +295,7 @@ def test_impacts_and_regime_log(nominal):
     assert log[1][1:] == (FREE, COUPLED_EXIT)
     times = [t for t, _, _ in log]
     assert times == sorted(times)
-    # Every coupled phase ends by the tooth leaving the face end (§3.3 [check]).
+    # Every coupled phase ends by the tooth leaving the face end (derived; OUTP's g test, App. A).
     whys = {why for _, a, b, why in nominal.events if a != FREE and b == FREE}
     assert whys == {"tooth left the face end (g = 0)"}
 
@@ -308,7 +308,7 @@ def test_friction_sensitivity(mu, turns):
 
 
 def test_as_run_indexing_first_cycle():
-    """The report's sample rows need the as-run mesh indexing rate (§9, §10.1 item 6)."""
+    """The report's sample rows need the as-run mesh indexing rate (derived from App. A output)."""
     r = run_m739(indexing=INDEXING_AS_RUN, t_stop=0.6e-3)
     t_end_coupled, t_impact = r.regime_log[0][0], r.regime_log[1][0]
     assert t_end_coupled == pytest.approx(0.41e-3, rel=0.01)

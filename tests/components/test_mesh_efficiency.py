@@ -1,4 +1,4 @@
-"""Mesh efficiency against Tepper (1981), note models/mesh_efficiency.md §6–§7, §9."""
+"""Mesh efficiency against Tepper (1981), ARLCD-TR-81020: Tables 14-22, Appendix E, Conclusions."""
 
 from __future__ import annotations
 
@@ -48,7 +48,7 @@ def test_involute_geometry_printed(table: int) -> None:
     pr = PRINTED_RUNS[table]
     assert g.form_radius / INCH == pytest.approx(pr.rf_in, abs=1e-4)
     assert g.undercut == pr.undercut
-    tol = 0.02 if table == 8 else 0.01  # T18 printed 20.71 needs CD ~ .34533 (note §7.1)
+    tol = 0.02 if table == 8 else 0.01  # T18 printed 20.71 needs CD ~ .34533 (derived)
     assert math.degrees(g.op_pressure_angle) == pytest.approx(pr.op_pressure_deg, abs=tol)
     assert g.contact_ratio == pytest.approx(pr.contact_ratio, abs=0.01)
     assert g.alpha_in / Z == pytest.approx(pr.alin_deg, abs=0.005)
@@ -108,7 +108,7 @@ def test_appendix_e_worst_point() -> None:
 
 def test_appendix_e_worked_points() -> None:
     g = appendix_e_geometry()
-    # note §9 worked checks: single contact at 14.03 deg and dual plateau, mu = 0.025
+    # App. E, p. 83: single contact at 14.03 deg and dual plateau, mu = 0.025
     assert involute_point_efficiency(g, 0.025, 14.03 * Z) == pytest.approx(0.9655, abs=5e-5)
     assert involute_point_efficiency(g, 0.025, 8.0 * Z) == pytest.approx(1.98304 / 2.05769, 1e-5)
 
@@ -128,7 +128,7 @@ def test_end_of_dual_contact_error_effect() -> None:
     assert np.array_equal(e_printed[a > 15.3 * Z], e_phys[a > 15.3 * Z])
 
 
-# -- invariants (note §7.7) -----------------------------------------------------------------
+# -- invariants (derived from eqs. 46, 47 and A-26) ------------------------------------------
 def test_invariants() -> None:
     g = involute_geometry(INVOLUTE_MESHES[6])
     _, eff0, cyc0, _ = involute_cycle(g, 0.0)
@@ -165,7 +165,8 @@ def test_general_statics_reproduces_a26() -> None:
             assert eff == pytest.approx(involute_point_efficiency(g, mu, alpha), rel=1e-12)
 
 
-# -- all nine meshes: cross-check with the note's independent recomputation (§9) -------------
+# -- all nine meshes: cross-check with an independent recomputation of eqs. 1-52 (K = 25,
+# physical ALFIN; not printed in the report) -----------------------------------------------
 SECTION_9 = {  # table: (min mu=.1, min mu=.3, cycle mu=.1, cycle mu=.3), physical ALFIN
     5: (.9680, .9091, .9704, .9147), 6: (.8666, .6594, .8734, .6854),
     7: (.8801, .6913, .8915, .7228), 9: (.9166, .7729, .9318, .8090),
@@ -184,7 +185,8 @@ def test_nine_meshes_cycle_and_minimum(table: int) -> None:
 
 
 def test_involute_conclusions() -> None:
-    """Report §6.3: involute minimum ~0.9 at mu = 0.1; its '~0.7 at 0.3' is optimistic (.606)."""
+    """Conclusions, p. 13: involute minimum ~0.9 at mu = 0.1; its '~0.7 at 0.3' is optimistic
+    (.606)."""
     mins_01, mins_03 = [], []
     for mesh in INVOLUTE_MESHES.values():
         _, mins = involute_sweep(involute_geometry(mesh), (0.1, 0.3))
@@ -225,7 +227,7 @@ def test_clock_kinematics_consistent(table: int) -> None:
 
 
 def test_clock_conclusions_18_leaf_meshes() -> None:
-    """Report §6.3: clock minimum efficiency ~0.8 at mu = 0.3 and ~0.9 at mu = 0.1 (graph
+    """Conclusions, p. 13: clock minimum efficiency ~0.8 at mu = 0.3 and ~0.9 at mu = 0.1 (graph
     readings, +-0.05), for the two meshes with 18-leaf pinions (Tables 1 and 4)."""
     mins = np.array([clock_sweep(CLOCK_MESHES[t], (0.1, 0.3), n=200)[1] for t in (1, 4)])
     assert mins[:, 1].min() == pytest.approx(0.8, abs=0.05)
@@ -238,7 +240,7 @@ def test_clock_conclusions_18_leaf_meshes() -> None:
     "and 0.847 at mu = 0.1, late in recess on the pinion flank (centre distance assumed)",
 )
 def test_clock_conclusions_all_four() -> None:
-    """Report §6.3: the lowest clock minimum efficiency of the four meshes is ~0.8 at 0.3."""
+    """Conclusions, p. 13: the lowest clock minimum efficiency of the four meshes is ~0.8 at 0.3."""
     mins = np.array([clock_sweep(mesh, (0.1, 0.3), n=200)[1] for mesh in CLOCK_MESHES.values()])
     assert mins[:, 1].min() == pytest.approx(0.8, abs=0.05)
     assert mins[:, 0].min() == pytest.approx(0.9, abs=0.05)

@@ -1,4 +1,4 @@
-"""Press roll feed of Xu (1993): components, monolithic reference, validation targets (§8).
+"""Press roll feed of Xu (1993): components, monolithic reference, targets (Table 1, App. H).
 
 Printed numbers are compared in the thesis's units (inch, lbf, degrees) after converting
 the SI results back with the factors of components.press_feed_data.
@@ -113,7 +113,7 @@ def test_kinematic_derivatives_match_finite_differences():
             fd = (vp[i] - vm[i]) / (2 * h)
             assert v[i + 1] == pytest.approx(fd, rel=1e-6, abs=1e-9)
     f2 = [kin(math.radians(d))[3] * IN for d in (0, 90, 270)]
-    assert f2 == pytest.approx([0.09638, 0.09649, 0.09976], abs=2e-5)  # §1.2 table
+    assert f2 == pytest.approx([0.09638, 0.09649, 0.09976], abs=2e-5)  # derived from (A.8)-(A.16)
 
 
 # -- V3: coupler ------------------------------------------------------------------------------
@@ -132,7 +132,8 @@ def test_run3_lumped_mass_lowers_the_coupler_frequency():
     k_e = coupler_stiffness(COUPLER_RUN3)
     m_e = coupler_modal_mass(COUPLER_RUN3) + J_O4 * APP_H_F2**2
     f = math.sqrt(k_e / m_e) / (2 * math.pi)
-    # G.9 with M = 9.1 lb gives 33.4 Hz; the thesis prints 32.5 Hz (§1.3, §10 item 11).
+    # G.9 with M = 9.1 lb gives 33.4 Hz; the thesis prints 32.5 Hz (Part I §7e; App. G's "near
+    # 0.005" is read as the 0.05 of G.9).
     assert f == pytest.approx(33.4, abs=0.1)
 
 
@@ -203,7 +204,8 @@ def test_v9_nonlinear_cycle_periodicity(run1):
 
 
 def test_linearized_regime2_extremes_match_the_notes_reproduction(app_h):
-    # §4.1 [recomputed]: max windup 0.0139 rad, q_max 0.0292 in in Regime 2 of App. H.
+    # Derived (App. H's linearized model integrated here; not printed in the thesis): max windup
+    # 0.0139 rad, q_max 0.0292 in in Regime 2 of App. H.
     cyc = app_h.cycles[0]
     assert cyc["peak_windup"] == pytest.approx(0.0139, rel=0.02)
     assert cyc["peak_q"] / IN == pytest.approx(0.0292, rel=0.02)
@@ -380,7 +382,7 @@ def test_clutch_hertz_option_uses_part3_stiffness():
     c.angle_outer = preload_windup(c.k_eff, T_B1)
     c.update_outputs()
     assert c.torque == pytest.approx(T_B1, rel=1e-12)
-    # per-sprag load N_h = T / (alpha R_i Z): about 98 lbf at 160 lbf.in (§9 item 2)
+    # per-sprag load N_h = T / (alpha R_i Z) (M.12, Table 4): about 98 lbf at 160 lbf.in
     assert c.contact_force / LBF == pytest.approx(98.0, rel=0.03)
 
 

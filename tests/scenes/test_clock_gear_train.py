@@ -1,6 +1,6 @@
 """The M739 rotor behind the two-pass clock train (ClockGearTrain), the verge's escapement
-centre distance, and the clock-train S&A scenes (notes models/clock_train_kinematics.md and
-models/sa_verge_escapement.md)."""
+centre distance, and the clock-train S&A scenes (kinematics of the US Army fuze report of about
+1980, Task 2; M739 data of Lowen & Tepper 1982, ARLCD-TR-82013)."""
 
 from __future__ import annotations
 
@@ -335,9 +335,9 @@ def test_full_arming_run_matches_the_monolithic_reference(tmp_path, fmu_cache) -
 
 @pytest.mark.slow
 def test_turns_to_arm_fall_as_the_escapement_center_distance_grows() -> None:
-    """The test plans' response (note §2.2) over the assumed band, monolithic models: turns
-    fall monotonically with the centre distance, with the relative sensitivity of the M739's
-    involute train (same escapement, same rotor travel) within 20 %."""
+    """The test plans' response (turns to arm, Test Plan 2) over the assumed band, monolithic
+    models: turns fall monotonically with the centre distance, with the relative sensitivity of
+    the M739's involute train (same escapement, same rotor travel) within 20 %."""
     turns = [run_clock_train(center_distance=float(cd)).turns for cd in M739_CD_SWEEP]
     assert all(t is not None for t in turns)
     assert all(b < a for a, b in zip(turns, turns[1:], strict=False)), turns

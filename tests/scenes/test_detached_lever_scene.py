@@ -1,5 +1,5 @@
 """Detached lever scenes through the FMU and the orchestrator, against Monday (1965) and exact
-solutions (note models/detached_lever.md §3.3, §5.1, §7)."""
+solutions (worked example, Ch. IV, pp. 39-45; Table I, p. 56)."""
 
 from __future__ import annotations
 
@@ -22,13 +22,14 @@ DECAY = SCENARIOS / "lever_unit_decay.toml"
 DECAY_ANGLE = SCENARIOS / "lever_unit_decay_angle_switched.toml"
 RATE = SCENARIOS / "lever_rate_vs_load.toml"
 
-# Note §7 A: cycle-end amplitudes of the worked-example deck, cycles 1-10, 20 and 41.
+# Cycle-end amplitudes of the worked-example deck, cycles 1-10, 20 and 41 (derived: the thesis's
+# Table III algorithm, p. 112, run in double precision on the Ch. IV deck).
 WORKED_FIRST_TEN = [5.548613, 4.926520, 4.397389, 3.947328, 3.564521,
                     3.238919, 2.961973, 2.726412, 2.526052, 2.355632]  # fmt: skip
 WORKED_STEADY = 1.38562
-WORKED_PERIOD = 0.388603  # s, 2 pi / omega1 (note §7 A)
+WORKED_PERIOD = 0.388603  # s, 2 pi / omega1 of the deck
 
-# The worked example's balance (the component defaults are its deck, note §3.3).
+# The worked example's balance (the component defaults are its deck, pp. 39-45).
 _DECK = DetachedLever()
 K, INERTIA = _DECK.stiffness, _DECK.inertia
 OMEGA0 = math.sqrt(K / INERTIA)
@@ -190,7 +191,7 @@ def test_rate_sweep_case_unit4(tmp_path, fmu_cache) -> None:
     r = run(RATE, tmp_path, fmu_cache, **_rate_case(4, 2))
     assert r.value("table_i_unit") == 4
     assert r.value("load_multiple") == pytest.approx(2.0, rel=1e-12)
-    # the thesis's computed unit curve at Table I's (C/omega0, K) = (0.050, 0.510): note §5.1
+    # the thesis's computed unit curve at Table I's (C/omega0, K) = (0.050, 0.510), derived
     assert r.value("cuc_steady_amplitude") == pytest.approx(3.573, abs=1e-3)
     # the refitted physical model meets it within the notch resolution of the measurements
     assert abs(r.value("steady_amplitude") - 3.573) < 0.104
@@ -214,7 +215,7 @@ def test_rate_against_load_unit1(tmp_path, fmu_cache) -> None:
     assert amps[0] < amps[1] < amps[2]  # amplitude grows with the drive ...
     assert periods[0] > periods[1] > periods[2] > free  # ... and the losing rate shrinks
     assert rates[0] < rates[1] < rates[2] < 0.0
-    # Table I's computed unit curves at loads 2, 4, 6 (note §5.1): 2.803, 4.165, 5.450 rad
+    # Table I's computed unit curves at loads 2, 4, 6 (derived steady values): 2.803, 4.165, 5.450
     np.testing.assert_allclose(amps, [2.803, 4.165, 5.450], atol=0.104)
     for r in results:
         assert r.accuracy["headline_error"] < 1e-8

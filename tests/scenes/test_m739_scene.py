@@ -1,5 +1,5 @@
 """The M739 scene through FMUs and the regime-aware master, against the report and the
-monolithic reference (Lowen & Tepper 1982; note models/sa_verge_escapement.md)."""
+monolithic reference (Lowen & Tepper 1982, ARLCD-TR-82013)."""
 
 from __future__ import annotations
 

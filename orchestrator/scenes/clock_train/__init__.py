@@ -1,4 +1,8 @@
-"""The clock-train S&A: the M739 verge driven through a clock (round-on-flank) gear train."""
+"""The clock-train S&A: the M739 verge driven through a clock (round-on-flank) gear train.
+
+Lowen & Tepper (1982), ARLCD-TR-82013, with the two-pass clock train kinematics of the US Army
+fuze report of about 1980 (Task 2).
+"""
 
 from orchestrator.scenes.family import Needs, Option, Role, SceneFamily
 

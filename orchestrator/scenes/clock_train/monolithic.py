@@ -1,4 +1,5 @@
-"""Monolithic model of the clock-train S&A: the M739 verge regime machine with the live
+"""Monolithic model of the clock-train S&A (Lowen & Tepper 1982; clock train kinematics of the
+US Army fuze report of about 1980, Task 2): the M739 verge regime machine with the live
 clock-train physics (``components.clock_gear_train.ClockTrainPhysics``) in place of a held
 affine response, one ODE with every event located, as ``orchestrator.scenes.m739.monolithic``
 does for the involute train; a tooth handover is an inelastic impact of the new pair."""
@@ -53,7 +54,7 @@ class _ClockMonolithic(VergeTrainMonolithic):
 
 def arming_phi(phys: ClockTrainPhysics, rotor_angle: float = ARMING_ROTOR_ANGLE) -> float:
     """Cumulative escape-wheel angle at which the rotor reaches rotor_angle (forward kinematics
-    of the train, note §4-5)."""
+    of the train, eqs. 1-87 of the clock train report)."""
     theta1 = phys.theta1_0 + (rotor_angle - phys.phi1c)
     return M739_TRAIN.escape_angle(theta1) - phys.psi0
 

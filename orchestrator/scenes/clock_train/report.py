@@ -1,5 +1,8 @@
 """The clock-train S&A scenes: the M739 verge escapement behind a two-pass clock gear train.
 
+Sources: the M739 rotor, verge and data of Lowen & Tepper (1982), ARLCD-TR-82013; the clock
+train kinematics of the US Army fuze report of about 1980 (Task 2, eqs. 1-126).
+
 Two FMUs meet at the escape-wheel shaft: ``train`` (ClockGearTrain: the M739 spin-driven rotor
 and the clock train of ``components.clock_train_kinematics``) and ``verge`` (VergeEscapement,
 with its

@@ -1,4 +1,4 @@
-"""The detached-lever escapement: beat amplitude, period and rate against drive torque."""
+"""The detached-lever escapement (Monday 1965): beat amplitude, period and rate against drive."""
 
 from orchestrator.scenes.family import Needs, Option, Role, SceneFamily
 

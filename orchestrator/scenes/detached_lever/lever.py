@@ -50,7 +50,7 @@ class LeverScene:
         return self.nominal if self.nominal is not None else self.free_period
 
     def map_args(self) -> dict[str, float]:
-        """Arguments of ``phase_cycle_map``: the deck per unit inertia (note §3.3)."""
+        """Arguments of ``phase_cycle_map``: the deck per unit inertia (Monday 1965, pp. 39-45)."""
         p = self.params
         i = p["inertia"]
         return {
@@ -91,7 +91,8 @@ class LeverScene:
 
     def table_i_k(self) -> float | None:
         """K of the thesis's computed unit curve at this load: Table I's value at its loads,
-        linear between and beyond them (note §5.1); None unless unit and load step are known."""
+        linear between and beyond them (Monday 1965, p. 56); None unless unit and load step are
+        known."""
         unit, m = self.table_i_unit(), self.load_multiple()
         if unit is None or m is None:
             return None

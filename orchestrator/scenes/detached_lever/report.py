@@ -2,7 +2,7 @@
 
 A scene holds one ``DetachedLever`` FMU (instance name from ``[report.options] lever``, else the
 only DetachedLever of the scene).  Its drive torque is the input's start value, held for the
-whole run: the train is not a separate body in this model (note models/detached_lever.md §1.2).
+whole run: the train is not a separate body in this model (Monday 1965, Ch. III, pp. 8-11).
 
 Per-cycle amplitudes are read from the recorded outputs, so any macro step well below half a
 balance period works (every switch is located exactly inside the FMU's step):
@@ -13,8 +13,9 @@ balance period works (every switch is located exactly inside the FMU's step):
   (an increment of ``beat_count`` with theta > 0).
 
 The reference is the same physics from the component module's pure functions: the affine
-cycle map of note §2.8 (mode 0), or the closed-form segments run extreme to extreme without
-macro steps, with the steady amplitude and period from the fixed point of the cycle map
+cycle map derived from Monday's Table III program (mode 0), or the closed-form segments run
+extreme to extreme without macro steps, with the steady amplitude and period from the fixed point
+of the cycle map
 (``steady_state``, mode 1).
 
 Rate is in seconds per day, positive when the balance runs fast: 86400 (T_nominal / T - 1),
@@ -48,7 +49,8 @@ from orchestrator.scenes.detached_lever.monolithic import beat_run
 from orchestrator.scenes.family import Quantity, Reference, quantity
 
 SECONDS_PER_DAY = 86400.0
-#: Cycles whose amplitude is reported by name (the note's §7 A lists 1-10, 20 and 41).
+#: Cycles whose amplitude is reported by name (the worked-example deck, Monday 1965, pp. 39-45,
+#: run through the Table III algorithm: cycles 1-10, 20 and 41 are checked in the tests).
 NAMED_CYCLES = (1, 2, 3, 10, 20, 41)
 
 
@@ -87,7 +89,7 @@ def cycle_amplitudes(
 
 
 def aitken(values: np.ndarray) -> float:
-    """Limit of a sequence from its last three terms (exact for an affine map, note §2.8)."""
+    """Limit of a sequence from its last three terms (exact for an affine map)."""
     if len(values) < 3:
         return float(values[-1])
     a, b, c = (float(v) for v in values[-3:])
@@ -137,7 +139,7 @@ def analyse(
     if lever.load_step is not None:
         out["load_multiple"] = quantity(lever.load_multiple(), "1")
     if k_cuc is not None:
-        # the thesis's computed unit curve at this unit and load (note §5.1): what the
+        # the thesis's computed unit curve at this unit and load (Table I, p. 56): what the
         # angle-switched model's friction and drive were refitted to
         out["cuc_steady_amplitude"] = quantity(
             unit_curve_steady(TABLE_I[unit].c_over_omega0, k_cuc), "rad"
@@ -162,8 +164,9 @@ def analyse(
         out["steady_amplitude"] = quantity(steady, "rad")
         out["amplitude_settling"] = quantity(abs(amps[-1] - steady), "rad")
         # Mode 0 schedules its windows on the phase: the cycle lasts 2 pi / omega1 by
-        # construction (note §0.4), and the speed may reverse inside a cycle (the draw can stop
-        # the balance before the impulse restarts it), so extremes do not measure it.
+        # construction (Monday 1965, Fig. 2, p. 11), and the speed may reverse inside a cycle
+        # (the draw can stop the balance before the impulse restarts it), so extremes do not
+        # measure it.
         period = lever.free_period if lever.mode == PHASE_SCHEDULED else float(col["period"][-1])
         if period > 0.0:
             out["period"] = quantity(period, "s")
@@ -296,7 +299,7 @@ def plot(scene: Scene, header: list[str], data: np.ndarray, path: Path) -> None:
     if lever.mode == ANGLE_SWITCHED and k_cuc is not None:
         # refitted Table I unit: its thesis curve is the computed unit curve at this load
         cw = TABLE_I[unit].c_over_omega0
-        # the computed unit curves all use the lift 0.2786896 rad (note §3.2)
+        # the computed unit curves all use the lift 0.2786896 rad (Monday 1965, p. 37)
         thesis = unit_curve(cw, k_cuc, n_map, theta0=p["theta_start"])
         steady = unit_curve_steady(cw, k_cuc)
         label = f"thesis computed unit curve, unit {unit}, K = {k_cuc:.3f}"
@@ -304,7 +307,7 @@ def plot(scene: Scene, header: list[str], data: np.ndarray, path: Path) -> None:
         thesis = phase_amplitudes(p["theta_start"], n_map, **lever.map_args())
         ratio, offset = phase_cycle_map(**lever.map_args())
         steady = offset / (1.0 - ratio) if ratio < 1.0 else math.nan  # undamped: no limit
-        label = "thesis cycle map (§2.8), same deck"
+        label = "thesis cycle map (Table III), same deck"
     ax.plot(np.arange(n_map + 1), thesis, "-", color="C2", lw=1.0, label=label)
     if steady == steady:
         ax.axhline(steady, color="C2", ls=":", lw=0.8, label="thesis steady amplitude")

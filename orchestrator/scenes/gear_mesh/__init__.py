@@ -1,4 +1,4 @@
-"""One involute or clock gear mesh: point and cycle efficiency against the closed form."""
+"""One involute or clock gear mesh (Tepper 1981): point and cycle efficiency against closed form."""
 
 from orchestrator.scenes.family import Needs, Role, SceneFamily
 

@@ -1,4 +1,4 @@
-"""Gear-mesh efficiency scenes (Tepper 1981, note models/mesh_efficiency.md): analysis, plot and
+"""Gear-mesh efficiency scenes (Tepper 1981, ARLCD-TR-81020): analysis, plot and
 closed-form reference.
 
 A scene holds one ``GearMesh`` FMU: a gear pair driven at a set speed against a load torque.

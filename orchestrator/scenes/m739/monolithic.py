@@ -159,7 +159,7 @@ def simulate(
     y = core._sync_kinematics([0.0, 0.0, 0.0, 0.0, 0.0])
     if core.k.omega == 0.0:
         return _finish(core, y, 0.0, False, "no spin: no driving torque", events, {})
-    core.s4 = core.s5 = 1  # V_S/T = 0 and psi_d = 0 at rest: +1 (§10.2 item 5)
+    core.s4 = core.s5 = 1  # V_S/T = 0 and psi_d = 0 at rest: +1 (the report's t = 0 row)
     core.record(y)  # the report's t = 0 printout uses these signs
     y = core.decide_direction(y, 0.0, 1)  # then all friction signs follow the motion
 

@@ -1,5 +1,7 @@
 """The M739 S&A scenes: turns to arm, contact-force maxima and impacts, and their yardstick.
 
+Targets of Lowen & Tepper (1982), ARLCD-TR-82013: Output Data (pp. 11-13) and Conclusions.
+
 The scene couples two FMUs at the escape-wheel shaft: ``train`` (GearTrain) and ``verge``
 (VergeEscapement), and stops when the cumulative escape-wheel angle reaches the arming
 angle (``scene.stop_when``).  Instance names come from ``[report.options]`` (defaults

@@ -1,4 +1,4 @@
-"""Monolithic reference of the press roll feed (Xu 1993, note ``press_feed_sprag.md``).
+"""Monolithic reference of the press roll feed (Xu 1993, Part I, Apps. A-H, Part II §4).
 
 The drive (crank + RSSR + elastic coupler), the sprag clutch and the brake/strip shaft are
 assembled into one ODE from the components' own physics functions and integrated with
@@ -20,7 +20,7 @@ in the forcing.  By default the regime ends (D.3, 62, E.3, F.3) use the same Fou
 ``event_kinematics="exact"`` uses the exact rocker instead.  The printed end of Regime 2
 (434.694 deg) is only met with the Fourier rocker (exact: 434.18 deg), the printed end of
 Regime 4 (615.642 deg) only with the exact one (Fourier: 615.22 deg); both stay within the
-0.5 deg of §8 V8 with the Fourier default.  Its clutch law has an offset (-T_b/2), so its
+0.5 deg (Tables H-6, H-8) with the Fourier default.  Its clutch law has an offset (-T_b/2), so its
 "energy" figures are not a balance.
 
 Options: clutch "hertz" takes K = alpha R_i Z G from the two-point contact (Part III) and
@@ -284,7 +284,7 @@ class _Linearized:
             spring = linearized_torque(w, 0.0, self.k_l3, 0.0, 0.0)
         else:
             spring = 0.0
-        # C_sp acts in the shaft equation and in D.3, not on the coupler (§2.2).
+        # C_sp acts in the shaft equation and in D.3, not on the coupler (linearized (12), App. C).
         return phi1, kin, w, wd, spring, spring + C_SP * wd if self.r != OVERRUN else 0.0
 
     def exact(self, t: float, y: np.ndarray) -> tuple[float, float]:
@@ -669,7 +669,7 @@ def _extrema(ts, w, sol) -> list[tuple[float, int]]:
 def simulate_decay_experiment(
     rpm: float, brake_torque: float, cycles: int = 1, j: float = J_PART2
 ) -> FeedResult:
-    """Part II experiment (§5.5): rigid Table 3 linkage, lumped clutch with (92) damping."""
+    """Part II experiment (Part II §4): rigid Table 3 linkage, lumped clutch with (92) damping."""
     o = FeedOptions(
         run=1,
         rpm=rpm,

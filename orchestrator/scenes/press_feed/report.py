@@ -2,7 +2,7 @@
 
 A press-feed scene holds one ``CrankCouplerDrive`` (crank, RSSR linkage, elastic coupler;
 the rocker is the clutch's outer race), one ``SpragClutch`` and one ``BrakeLoad`` (roller
-shaft, strip, brake).  The thesis regimes of a cycle (note §2.1) follow from the three
+shaft, strip, brake).  The thesis regimes of a cycle (Part I §3f, p. 14) follow from the three
 discrete states: 1 windup (engaged, shaft stuck, rocker forward), 2 feed (shaft slipping),
 3 unwinding (engaged, stuck, rocker returning), 4 overrun (clutch disengaged).
 
@@ -158,7 +158,8 @@ def regime_timing(
 
     Fractions of the cycle spent in each regime; crank angles of the first break-away
     (feed), of the first return with the shaft stuck (unwind), of the last disengagement
-    (overrun; a clutch that unloads mid-feed, note §9 item 5, disengages more than once:
+    (overrun; a clutch that unloads mid-feed, which the thesis
+    excludes by its eq. (65), disengages more than once:
     ``disengagements`` counts them) and of the last engagement (``engage_angle``).
 
     ``transitions`` are (time, regime entered), in time order, starting at or before t0;
