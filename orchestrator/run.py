@@ -68,6 +68,7 @@ def run_scene(
     cache_dir: Path | None = None,
     show_progress: bool = True,
     compare_reference: bool = True,
+    plots: bool = True,
 ) -> RunResult:
     """Run ``scene`` and write its results under ``output_dir`` (default: the scene's).
 
@@ -76,7 +77,7 @@ def run_scene(
     """
     out = Path(output_dir) if output_dir else scene.output_dir
     with catching_signals() as guard, OutputLock(out):
-        return _run_locked(scene, out, cache_dir, show_progress, compare_reference, guard)
+        return _run_locked(scene, out, cache_dir, show_progress, compare_reference, plots, guard)
 
 
 def _run_locked(
@@ -85,6 +86,7 @@ def _run_locked(
     cache_dir: Path | None,
     show_progress: bool,
     compare_reference: bool,
+    plots: bool,
     guard: SignalGuard,
 ) -> RunResult:
     fmu_paths = fmu_files(scene, cache_dir)
@@ -149,7 +151,7 @@ def _run_locked(
         # No FMU is alive any more: a signal may now stop the analyses where it lands.
         with guard.raise_at_once(), _without_numeric_warnings():
             quantities, accuracy = _analyse(
-                scene, out, recorder, data, status, compare_reference, notes
+                scene, out, recorder, data, status, compare_reference, plots, notes
             )
     except Interrupted as exc:
         if status == "completed":
@@ -198,6 +200,7 @@ def _analyse(
     data: np.ndarray,
     status: str,
     compare_reference: bool,
+    plots: bool,
     notes: list[str],
 ) -> tuple[dict[str, dict[str, Any]], dict[str, float]]:
     """Headline, energy residual, scene analysis, plot and error against the reference:
@@ -213,7 +216,7 @@ def _analyse(
     if scene.analysis and status == "completed":
         with _noted(notes, f"analysis {scene.analysis!r}", header):
             quantities.update(ANALYSES[scene.analysis](scene, header, data, scene.analysis_options))
-        if scene.analysis in PLOTS and len(data) > 1:
+        if plots and scene.analysis in PLOTS and len(data) > 1:
             with _noted(notes, f"plot of {scene.analysis!r}", header):
                 PLOTS[scene.analysis](scene, header, data, out / f"{scene.name}.png")
     accuracy: dict[str, float] = {}
