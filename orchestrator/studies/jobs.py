@@ -102,7 +102,8 @@ def iter_jobs(
     """Run ``jobs`` in parallel and yield (index, result) as each finishes, an exception in
     place of the result when the job raised (e.g. a sample its scene refuses).  When
     ``stop()`` turns true no further job starts; those under way still report.  The FMUs
-    must be built beforehand (load the scene once)."""
+    must be built beforehand (load the scene once).  One worker runs the jobs in this
+    process (a signal then stops the job under way at a step boundary, as ``run`` does)."""
     if not jobs:
         return
     stop = stop or (lambda: False)
@@ -110,6 +111,15 @@ def iter_jobs(
         yield from _iter_dask(jobs, dask_address, stop)
         return
     workers = workers or min(len(jobs), os.cpu_count() or 1)
+    if workers == 1:  # in this process, one after another: no pool to start
+        for k, job in enumerate(jobs):
+            if stop():
+                return
+            try:
+                yield k, run_job(job)
+            except Exception as exc:  # noqa: BLE001 - reported as the job's outcome
+                yield k, exc
+        return
     context = mp.get_context("spawn")
     with ProcessPoolExecutor(workers, mp_context=context, initializer=_ignore_sigint) as pool:
         futures = {pool.submit(run_job, job): k for k, job in enumerate(jobs)}

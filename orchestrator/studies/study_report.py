@@ -21,7 +21,11 @@ def _pct(x: float) -> str:
 
 
 def _ci(e: st.Estimate) -> str:
-    return f"{_g(e.low)} … {_g(e.high)}" if math.isfinite(e.low) else "–"
+    if math.isnan(e.low) or math.isnan(e.high):
+        return "–"
+    low = _g(e.low) if math.isfinite(e.low) else "−∞ (too few samples)"
+    high = _g(e.high) if math.isfinite(e.high) else "∞ (too few samples)"
+    return f"{low} … {high}"
 
 
 def limit_rows(result: StudyResult) -> list[tuple[str, str, st.Violation, int]]:
@@ -92,8 +96,9 @@ def write_markdown(result: StudyResult, path: Path) -> None:
             "",
             f"## {q}" + (f" [{unit}]" if unit and unit != "1" else ""),
             "",
-            f"From the {summary.n} samples with a value; 95 % percentile-bootstrap intervals "
-            f"({st.RESAMPLES} resamples).",
+            f"From the {summary.n} samples with a value; 95 % intervals: bootstrap "
+            f"({st.RESAMPLES} resamples) for mean and deviation, exact order-statistic "
+            "intervals for the percentiles.",
             "",
             "| statistic | value | 95 % interval |",
             "|---|---|---|",
@@ -186,8 +191,10 @@ def write_plot(result: StudyResult, path: Path) -> None:
             cdf.step(y, np.arange(1, n + 1) / n, where="post", color="C0", label=f"{n} samples")
             summary = st.summarize(y, seed=result.spec.seed)
             for p, e in summary.percentiles.items():
-                if math.isfinite(e.low):
-                    cdf.plot([e.low, e.high], [p / 100, p / 100], color="C3", lw=3, alpha=0.6)
+                if not math.isnan(e.low):
+                    lo = e.low if math.isfinite(e.low) else y[0]
+                    hi = e.high if math.isfinite(e.high) else y[-1]
+                    cdf.plot([lo, hi], [p / 100, p / 100], color="C3", lw=3, alpha=0.6)
                 cdf.plot(e.value, p / 100, "|", color="C3", ms=10)
             cdf.plot([], [], color="C3", lw=3, alpha=0.6, label="percentiles, 95 % CI")
         lim = limits.get(q)

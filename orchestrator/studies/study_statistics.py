@@ -1,9 +1,15 @@
 """Statistics of a tolerance study that say how far they can be trusted.
 
-* Mean, standard deviation and percentiles, each with a percentile-bootstrap confidence
-  interval (resampling the completed samples; seeded, so the same samples give the same
-  interval).  With Sobol points the bootstrap treats the samples as independent, which
-  overstates the spread of the mean: the intervals are then conservative.
+* Mean and standard deviation with a percentile-bootstrap confidence interval (resampling
+  the completed samples; seeded, so the same samples give the same interval).
+* Percentiles with the exact distribution-free interval between two order statistics (the
+  number of samples below a quantile is binomial).  The bootstrap's percentile intervals
+  cannot reach past the smallest or largest sample and miss the 1 % and 99 % points far
+  more often than 5 % at a few dozen samples; these intervals hold their level, and stay
+  open on a side the samples cannot bound yet (the 1 % point needs 368 samples for a
+  two-sided 95 % interval).
+  With Sobol points every interval treats the samples as independent, which overstates the
+  spread of the estimates: the intervals are then conservative.
 * Violation probability of an acceptance limit: k of n with the exact Clopper-Pearson
   interval, and the one-sided upper bound ("0 of 500" reads "< 0.6 % at 95 %").
 * Convergence: the standard error of the mean against N for these samples (s/sqrt(N)), and
@@ -81,11 +87,25 @@ def summarize(values: np.ndarray, seed: int = 0) -> Summary:
     def sd(v: np.ndarray, axis: int = -1) -> np.ndarray:
         return np.std(v, axis=axis, ddof=1) if v.shape[axis] > 1 else np.zeros(v.shape[:-1])
 
-    percentiles = {
-        p: _bootstrap(x, lambda v, axis=-1, p=p: np.percentile(v, p, axis=axis), seed + p)
-        for p in PERCENTILES
-    }
+    percentiles = {p: percentile_interval(x, p) for p in PERCENTILES}
     return Summary(len(x), _bootstrap(x, np.mean, seed), _bootstrap(x, sd, seed + 1), percentiles)
+
+
+def percentile_interval(values: np.ndarray, p: float) -> Estimate:
+    """The p-th percentile and its exact distribution-free interval [x(l), x(u)]: with B
+    the number of samples below the true quantile, B ~ Binomial(n, p/100), so
+    P(x(l) <= q) = P(B >= l) and P(x(u) >= q) = P(B < u), each held >= 1 - alpha/2.  A side
+    no order statistic reaches at this n is infinite."""
+    x = np.sort(np.asarray(values, dtype=float))
+    n, q = len(x), p / 100.0
+    value = float(np.percentile(x, p))
+    tail = (1.0 - CONFIDENCE) / 2.0
+    ranks = np.arange(1, n + 1)
+    below = stats.binom.sf(ranks - 1, n, q) >= 1.0 - tail  # P(B >= l)
+    above = stats.binom.cdf(ranks - 1, n, q) >= 1.0 - tail  # P(B < u)
+    low = float(x[ranks[below][-1] - 1]) if below.any() else -math.inf
+    high = float(x[ranks[above][0] - 1]) if above.any() else math.inf
+    return Estimate(value, low, high)
 
 
 def violation(k: int, n: int) -> Violation:

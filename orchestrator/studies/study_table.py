@@ -299,18 +299,19 @@ def _scene_value(loader: Any, key: str, fmus: dict[str, Any], where: str) -> flo
 
 
 def _check_range(loader: Any, spec: StudyInput, where: str, fmus: dict[str, Any]) -> None:
-    """A bounded distribution stays within the range the FMU declares for every key."""
+    """A distribution bounded on a side stays within the range the FMU declares there (an
+    unbounded one may reach past it: those samples fail, and are counted, at run time)."""
     low, high = spec.support
     for key in spec.keys:
         parts = key.split(".", 3)
         if len(parts) != 4 or parts[0] != "fmus":
             continue
         var = fmus[parts[1]].model.variables[parts[3]]
-        if var.min is not None and low < var.min:
+        if var.min is not None and math.isfinite(low) and low < var.min:
             raise loader.fail(
                 where, f"reaches {low:.6g} {spec.unit}, below {key}'s minimum {var.min:g}"
             )
-        if var.max is not None and high > var.max:
+        if var.max is not None and math.isfinite(high) and high > var.max:
             raise loader.fail(
                 where, f"reaches {high:.6g} {spec.unit}, above {key}'s maximum {var.max:g}"
             )
