@@ -122,8 +122,9 @@ def write_markdown(result: StudyResult, path: Path) -> None:
             lines += [
                 "",
                 "Standard error of the mean against N: these samples (s/√N), and Monte Carlo "
-                "against scrambled Sobol from 64 draws each of a quadratic fit of the results "
-                f"(fit R² = {_g(fit_r2, 3)}):",
+                "against scrambled Sobol from 64 draws each of a least-squares fit of the "
+                f"results (quadratic, or linear below two samples per coefficient; "
+                f"fit R² = {_g(fit_r2, 3)}, – when too few samples for either):",
                 "",
                 "| N | this study | Monte Carlo (fit) | Sobol (fit) |",
                 "|---|---|---|---|",
@@ -211,7 +212,9 @@ def write_plot(result: StudyResult, path: Path) -> None:
         if ns:
             conv.loglog(ns, se, "o-", label="these samples, s/√N")
             for method, ses in comparison.items():
-                conv.loglog(ns, ses, ".--", label=f"{method} (quadratic fit, R² {r2:.2f})")
+                conv.loglog(ns, ses, ".--", label=f"{method} (on the fit, R² {r2:.2f})")
+            conv.set_xticks(ns, [str(n) for n in ns])
+            conv.minorticks_off()
         conv.set_xlabel("samples N")
         conv.set_ylabel(
             f"standard error of mean{' [' + unit + ']' if unit not in ('', '1') else ''}"

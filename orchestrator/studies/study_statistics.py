@@ -163,14 +163,16 @@ def surrogate_convergence(
 ) -> tuple[dict[str, list[float]], float]:
     """Standard error of the mean against N for Monte Carlo and scrambled Sobol, from
     ``replicates`` independent draws each of a quadratic fit of y over the unit points
-    ``u`` (the study's own points before the inverse CDFs).  Returns ({method: SEs}, R^2
-    of the fit); empty when there are too few samples for the fit."""
+    ``u`` (the study's own points before the inverse CDFs); linear when there are fewer
+    than two samples per coefficient of the quadratic.  Returns ({method: SEs}, R^2 of the
+    fit); empty when there are too few samples even for the linear fit."""
     u = np.asarray(u, dtype=float)
     y = np.asarray(y, dtype=float)
     features = _features(u)
-    if len(y) < features.shape[1] + 2:
+    # At least two samples per coefficient, else the fit follows the samples, not the model.
+    if len(y) < 2 * features.shape[1]:
         features = features[:, : 1 + u.shape[1]]  # linear only
-        if len(y) < features.shape[1] + 2:
+        if len(y) < 2 * features.shape[1]:
             return {}, math.nan
     quadratic = features.shape[1] > 1 + u.shape[1]
     coef, *_ = np.linalg.lstsq(features, y, rcond=None)
