@@ -73,17 +73,18 @@ class StudyInput:
 
     def describe(self) -> str:
         """The distribution in words, for the study's report."""
-        kind, p, u = self.distribution, self.params, self.unit
+        kind, p = self.distribution, self.params
+        u = "" if self.unit == "1" else self.unit
         if kind == "band":
             shape = "uniform" if p[2] else f"truncated normal, ±{BAND_SIGMAS:g}σ"
-            return f"{p[0]:.6g} ± {p[1]:.3g} {u} ({shape})"
+            return f"{p[0]:.6g} ± {p[1]:.3g} {u} ({shape})".replace("  ", " ")
         if kind == "normal":
-            return f"normal, mean {p[0]:.6g} {u}, sd {p[1]:.3g} {u}"
+            return f"normal, mean {p[0]:.6g} {u}, sd {p[1]:.3g} {u}".replace(" ,", ",").strip()
         if kind == "uniform":
-            return f"uniform {p[0]:.6g} … {p[1]:.6g} {u}"
+            return f"uniform {p[0]:.6g} … {p[1]:.6g} {u}".strip()
         if kind == "lognormal":
-            return f"lognormal, median {p[0]:.6g} {u}, σ(ln) {p[1]:.3g}"
-        return f"one of {', '.join(f'{v:.6g}' for v in p)} {u}"
+            return f"lognormal, median {p[0]:.6g} {u}, σ(ln) {p[1]:.3g}".replace(" ,", ",")
+        return f"one of {', '.join(f'{v:.6g}' for v in p)} {u}".strip()
 
 
 @dataclass(frozen=True)

@@ -62,6 +62,8 @@ class StudyResult:
     workers: str
     interrupted: int | None = None  # the signal that stopped the study
     units: dict[str, str] = field(default_factory=dict)
+    invocations: list[dict[str, Any]] = field(default_factory=list)  # runs.json: every
+    # invocation of the study on this directory (samples run, wall time, where)
 
     def values(self, quantity: str) -> np.ndarray:
         """The quantity over the samples that gave every quantity (status ok)."""
@@ -144,7 +146,12 @@ def run_study(
         )
         for k in todo
     ]
-    where = f"Dask at {dask_address}" if dask_address else f"{workers or 'one per core'} workers"
+    if dask_address:
+        where = f"Dask at {dask_address}"
+    elif workers == 1:
+        where = "1 worker, in process"
+    else:
+        where = f"{workers} workers" if workers else "one worker per core"
     units: dict[str, str] = {}
     start = time.perf_counter()
     interrupted: int | None = None
@@ -173,6 +180,7 @@ def run_study(
     bar.close()
     wall = time.perf_counter() - start
     _rewrite(csv_path, spec, done)
+    invocations = _log_invocation(out_dir, resume, len(done) - (n - len(todo)), wall, where)
     result = StudyResult(
         scene,
         spec,
@@ -184,6 +192,7 @@ def run_study(
         where,
         interrupted,
         {**_saved_units(out_dir, done, spec), **units},
+        invocations,
     )
     from orchestrator.studies.study_report import write_markdown, write_plot
 
@@ -218,6 +227,23 @@ def _sample(k: int, inputs: np.ndarray, outcome: Any, spec: StudySpec) -> Sample
         why = f"no value of {', '.join(missing)}" + (f" ({notes[0]})" if notes else "")
         return Sample(k, row, NO_VALUE, values, why)
     return Sample(k, row, OK, values)
+
+
+def _log_invocation(
+    out_dir: Path, resume: bool, ran: int, wall: float, where: str
+) -> list[dict[str, Any]]:
+    """Append this invocation to ``runs.json`` (started afresh unless resuming): the
+    study's run time, which samples.csv leaves out to stay the same wherever it ran."""
+    path = out_dir / "runs.json"
+    log: list[dict[str, Any]] = []
+    if resume:
+        try:
+            log = json.loads(path.read_text())
+        except (OSError, ValueError):
+            log = []
+    log.append({"samples_run": ran, "wall_time": round(wall, 3), "where": where})
+    path.write_text(json.dumps(log, indent=1) + "\n")
+    return log
 
 
 def _drop_series(run_dir: Path) -> None:
