@@ -14,6 +14,7 @@ import warnings
 from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
+from functools import cache
 from importlib import metadata
 from pathlib import Path
 from typing import Any
@@ -269,13 +270,20 @@ def reference_of(scene: Scene) -> Reference:
     return ref
 
 
-def _metadata(scene: Scene, fmu_paths: dict[str, Path]) -> dict[str, Any]:
-    versions = {}
+@cache
+def _versions() -> dict[str, str | None]:
+    """Installed versions (read once a process: a study runs hundreds of scenes in one)."""
+    versions: dict[str, str | None] = {}
     for package in ("fmpy", "pythonfmu", "numpy", "scipy", "pint"):
         try:
             versions[package] = metadata.version(package)
         except metadata.PackageNotFoundError:
             versions[package] = None
+    return versions
+
+
+def _metadata(scene: Scene, fmu_paths: dict[str, Path]) -> dict[str, Any]:
+    versions = dict(_versions())
     return {
         "scene_file": str(scene.path),
         "scene_sha256": file_sha256(scene.path),
