@@ -97,6 +97,21 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--dask", metavar="ADDRESS", help="run the sweep on this Dask scheduler")
     p.set_defaults(handler=_sweep)
 
+    p = sub.add_parser(
+        "study", help="run a scene's [study]: tolerances varied at once, statistics of the results"
+    )
+    p.add_argument("scene", type=Path)
+    p.add_argument("--samples", type=int, help="number of samples (default: the scene's)")
+    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
+    p.add_argument("--output", type=Path, help="directory (default runs/<scene>/study)")
+    p.add_argument("--workers", type=int, help="local processes (default: one per core)")
+    p.add_argument("--dask", metavar="ADDRESS", help="run the samples on this Dask scheduler")
+    p.add_argument(
+        "--resume", action="store_true", help="keep the samples in samples.csv, run the rest"
+    )
+    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    p.set_defaults(handler=_study)
+
     p = sub.add_parser("stability", help="run the stability suite (scenarios/stability/)")
     p.add_argument("--output", type=Path, default=Path("runs") / "stability")
     p.add_argument("--workers", type=int, help="local processes (default: one per core)")
@@ -321,6 +336,41 @@ def _sweep(args: argparse.Namespace) -> int:
     print((result.output_dir / "sweep.md").read_text())
     print(f"results in {result.output_dir} (sweep.csv, sweep.png, sweep.md)")
     return 0 if all(r["status"] == "completed" for r in result.rows) else 1
+
+
+def _study(args: argparse.Namespace) -> int:
+    from orchestrator.studies.study_report import limit_rows
+    from orchestrator.studies.study_statistics import summarize
+    from orchestrator.studies.tolerance_study import OK, run_study
+
+    result = run_study(
+        args.scene,
+        samples=args.samples,
+        workers=args.workers,
+        dask_address=args.dask,
+        resume=args.resume,
+        overrides=_overrides(args.set) or None,
+        output_dir=args.output,
+        show_progress=not args.no_progress,
+    )
+    ok = sum(s.status == OK for s in result.samples)
+    print(
+        f"study {result.scene.name}: {len(result.samples)} of {result.requested} samples, "
+        f"{ok} with every quantity; {result.ran} run in {result.wall_time:.1f} s"
+    )
+    for s in result.samples:
+        if s.status != OK:
+            print(f"  sample {s.index}: {s.status}: {s.reason}")
+    for q in result.spec.quantities:
+        summary = summarize(result.values(q), seed=result.spec.seed)
+        pct = ", ".join(f"p{p} {e.value:.5g}" for p, e in summary.percentiles.items())
+        print(f"  {q}: mean {summary.mean.value:.6g}, sd {summary.sd.value:.4g}; {pct}")
+    for q, words, v, _ in limit_rows(result):
+        print(f"  {q} {words}: {v.k} of {v.n} violate, < {100 * v.upper:.3g} % at 95 %")
+    print(f"results in {result.output_dir} (samples.csv, study.md, study.png)")
+    if result.interrupted is not None:
+        return 128 + result.interrupted
+    return 0 if ok else 1
 
 
 def _stability(args: argparse.Namespace) -> int:

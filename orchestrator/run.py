@@ -14,6 +14,7 @@ import warnings
 from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
+from functools import cache
 from importlib import metadata
 from pathlib import Path
 from typing import Any
@@ -69,6 +70,7 @@ def run_scene(
     cache_dir: Path | None = None,
     show_progress: bool = True,
     compare_reference: bool = True,
+    plots: bool = True,
 ) -> RunResult:
     """Run ``scene`` and write its results under ``output_dir`` (default: the scene's).
 
@@ -77,7 +79,7 @@ def run_scene(
     """
     out = Path(output_dir) if output_dir else scene.output_dir
     with catching_signals() as guard, OutputLock(out):
-        return _run_locked(scene, out, cache_dir, show_progress, compare_reference, guard)
+        return _run_locked(scene, out, cache_dir, show_progress, compare_reference, plots, guard)
 
 
 def _run_locked(
@@ -86,6 +88,7 @@ def _run_locked(
     cache_dir: Path | None,
     show_progress: bool,
     compare_reference: bool,
+    plots: bool,
     guard: SignalGuard,
 ) -> RunResult:
     fmu_paths = fmu_files(scene, cache_dir)
@@ -150,7 +153,7 @@ def _run_locked(
         # No FMU is alive any more: a signal may now stop the analyses where it lands.
         with guard.raise_at_once(), _without_numeric_warnings():
             quantities, accuracy = _analyse(
-                scene, out, recorder, data, status, compare_reference, notes
+                scene, out, recorder, data, status, compare_reference, plots, notes
             )
     except Interrupted as exc:
         if status == "completed":
@@ -199,6 +202,7 @@ def _analyse(
     data: np.ndarray,
     status: str,
     compare_reference: bool,
+    plots: bool,
     notes: list[str],
 ) -> tuple[dict[str, dict[str, Any]], dict[str, float]]:
     """Headline, energy residual, scene analysis, plot and error against the reference:
@@ -214,7 +218,7 @@ def _analyse(
     if scene.analysis and status == "completed":
         with _noted(notes, f"analysis {scene.analysis!r}", header):
             quantities.update(ANALYSES[scene.analysis](scene, header, data, scene.analysis_options))
-        if scene.analysis in PLOTS and len(data) > 1:
+        if plots and scene.analysis in PLOTS and len(data) > 1:
             with _noted(notes, f"plot of {scene.analysis!r}", header):
                 PLOTS[scene.analysis](scene, header, data, out / f"{scene.name}.png")
     accuracy: dict[str, float] = {}
@@ -267,13 +271,20 @@ def reference_of(scene: Scene) -> Reference:
     return ref
 
 
-def _metadata(scene: Scene, fmu_paths: dict[str, Path]) -> dict[str, Any]:
-    versions = {}
+@cache
+def _versions() -> dict[str, str | None]:
+    """Installed versions (read once a process: a study runs hundreds of scenes in one)."""
+    versions: dict[str, str | None] = {}
     for package in ("fmpy", "pythonfmu", "numpy", "scipy", "pint"):
         try:
             versions[package] = metadata.version(package)
         except metadata.PackageNotFoundError:
             versions[package] = None
+    return versions
+
+
+def _metadata(scene: Scene, fmu_paths: dict[str, Path]) -> dict[str, Any]:
+    versions = dict(_versions())
     return {
         "scene_file": str(scene.path),
         "scene_sha256": file_sha256(scene.path),

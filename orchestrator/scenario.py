@@ -29,6 +29,7 @@ from orchestrator.master_settings import (
 from orchestrator.model_info import ModelInfo, ModelInfoError, VariableInfo, model_info
 from orchestrator.scenes import ANALYSES, REFERENCES, family
 from orchestrator.scenes.family import Option
+from orchestrator.studies.study_table import StudySpec, parse_study
 from orchestrator.units import to_si
 
 REDUCTIONS = ("final", "initial", "max", "min", "maxabs", "mean")
@@ -125,6 +126,7 @@ class Scene:
     stop_when: StopCondition | None = None
     error_bound: float = math.inf  # the error against the reference the scene claims
     sweep: SweepSpec | None = None  # run by ``mechcosim sweep``; ``run`` ignores it
+    study: StudySpec | None = None  # run by ``mechcosim study``; ``run`` ignores it
 
     def component_class(self, instance: str) -> type[Component]:
         """The physics behind one of our FMUs (for scene analyses and references only:
@@ -263,7 +265,9 @@ class _Loader:
     def scene(self) -> Scene:
         raw = self.table(self.raw, "")
         self.check_keys(
-            raw, "", {"scene", "fmus", "connections", "master", "output", "report", "sweep"}
+            raw,
+            "",
+            {"scene", "fmus", "connections", "master", "output", "report", "sweep", "study"},
         )
         for section in ("scene", "fmus", "master"):
             if section not in raw:
@@ -289,6 +293,7 @@ class _Loader:
         headline, analysis, options, reference, error_bound = self.report(report, fmus)
         self.report_needs(headline, analysis, reference, options, fmus, record)
         sweep = self.sweep(raw["sweep"], fmus) if "sweep" in raw else None
+        study = self.study(raw["study"], fmus) if "study" in raw else None
         return Scene(
             path=self.path,
             name=name,
@@ -308,6 +313,7 @@ class _Loader:
             stop_when=stop_when,
             error_bound=error_bound,
             sweep=sweep,
+            study=study,
         )
 
     def shared_parameters(self, fmus: dict[str, FmuSpec]) -> None:
@@ -745,6 +751,10 @@ class _Loader:
         return SweepSpec(
             parameter, tuple(values), si, unit or "1", label, tuple(quantities), tuple(series)
         )
+
+    def study(self, node: Any, fmus: dict[str, FmuSpec]) -> StudySpec:
+        """The [study] table (orchestrator.studies.study_table)."""
+        return parse_study(self, node, fmus)
 
     def swept_unit(self, dotted: str, fmus: dict[str, FmuSpec], key: str = "sweep.parameter"):
         """SI unit of a key a sweep may set (None: a plain value); fails on unknown keys."""

@@ -9,7 +9,9 @@ from __future__ import annotations
 
 import multiprocessing as mp
 import os
-from concurrent.futures import ProcessPoolExecutor
+import signal
+from collections.abc import Callable, Iterator
+from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -29,6 +31,7 @@ class Job:
     #: compare with the scene's reference inside the run; a study that shares one
     #: reference among its jobs computes it once itself and says False
     compare_reference: bool = True
+    plots: bool = True  # draw the scene analysis's plot
 
 
 @dataclass
@@ -51,6 +54,7 @@ def run_job(job: Job) -> JobResult:
         output_dir=Path(job.output_dir),
         show_progress=False,
         compare_reference=job.compare_reference,
+        plots=job.plots,
     )
     return JobResult(
         job,
@@ -82,3 +86,73 @@ def run_jobs(
     # Spawned workers: pythonfmu's runtime must not inherit a parent's loaded FMUs.
     with ProcessPoolExecutor(max_workers=workers, mp_context=mp.get_context("spawn")) as pool:
         return list(pool.map(run_job, jobs))
+
+
+def _ignore_sigint() -> None:
+    """Pool workers leave Ctrl-C to the parent, which stops handing out jobs; a job under
+    way finishes (run_scene keeps a SIGINT the process ignores ignored)."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+def iter_jobs(
+    jobs: list[Job],
+    workers: int | None = None,
+    dask_address: str | None = None,
+    stop: Callable[[], bool] | None = None,
+) -> Iterator[tuple[int, JobResult | Exception]]:
+    """Run ``jobs`` in parallel and yield (index, result) as each finishes, an exception in
+    place of the result when the job raised (e.g. a sample its scene refuses).  When
+    ``stop()`` turns true no further job starts; those under way still report.  The FMUs
+    must be built beforehand (load the scene once).  One worker runs the jobs in this
+    process (a signal then stops the job under way at a step boundary, as ``run`` does)."""
+    if not jobs:
+        return
+    stop = stop or (lambda: False)
+    if dask_address:
+        yield from _iter_dask(jobs, dask_address, stop)
+        return
+    workers = workers or min(len(jobs), os.cpu_count() or 1)
+    if workers == 1:  # in this process, one after another: no pool to start
+        for k, job in enumerate(jobs):
+            if stop():
+                return
+            try:
+                yield k, run_job(job)
+            except Exception as exc:  # noqa: BLE001 - reported as the job's outcome
+                yield k, exc
+        return
+    context = mp.get_context("spawn")
+    with ProcessPoolExecutor(workers, mp_context=context, initializer=_ignore_sigint) as pool:
+        futures = {pool.submit(run_job, job): k for k, job in enumerate(jobs)}
+        pending = set(futures)
+        stopping = False
+        while pending:
+            if not stopping and stop():
+                stopping = True
+                for future in pending:
+                    future.cancel()
+                pending = {f for f in pending if not f.cancelled()}
+            done, pending = wait(pending, timeout=0.25, return_when=FIRST_COMPLETED)
+            for future in sorted(done, key=futures.__getitem__):
+                if future.cancelled():
+                    continue
+                error = future.exception()
+                yield futures[future], error if error is not None else future.result()
+
+
+def _iter_dask(
+    jobs: list[Job], address: str, stop: Callable[[], bool]
+) -> Iterator[tuple[int, JobResult | Exception]]:
+    from dask.distributed import Client, as_completed
+
+    with Client(address) as client:
+        futures = client.map(run_job, jobs, pure=False)
+        index = {f.key: k for k, f in enumerate(futures)}
+        finished = as_completed(futures)
+        for future in finished:
+            error = future.exception() if future.status == "error" else None
+            yield index[future.key], error if error is not None else future.result()
+            if stop():
+                running = [f for f in futures if not f.done()]
+                client.cancel(running)
+                break
