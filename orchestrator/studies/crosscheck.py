@@ -1,68 +1,378 @@
-"""Run a scene in libcosim (libcosimpy) at a fixed step: proof that our FMUs are standard.
+"""Run a scene's exported system in another tool at a fixed step and compare it with our
+Jacobi master: proof that the FMUs and the export are standard.
+
+The tools see only what ``mechcosim export`` writes:
+
+* ``libcosim`` (libcosimpy) loads the SSP archive (unpacked; the OSP annotation gives its
+  fixed-step algorithm and step) or the OSP-IS ``OspSystemStructure.xml`` and steps its
+  fixed-step algorithm (every FMU steps, then values are transferred: Jacobi).
+* ``fmpy`` reads the SSP archive with FMPy's SSD reader (which checks it against the SSP
+  schema) and steps FMPy's ``FMU2Slave`` instances in a fixed-step Jacobi loop of its own:
+  bound values set in initialization mode, the initial exchange settled once per instance,
+  then inputs held over each step.  (FMPy's ``simulate_ssp`` cannot stand in: it starts
+  every connection at 0.0 and writes 0.0 over input values bound in the SSD.)
+
+Agreement, per recorded signal, is ``max_k |ours_k - theirs_k| / max_k max(|ours_k|,
+|theirs_k|)`` over the common communication points k = 1..n (0 when both are zero
+throughout); the agreement of a run is the largest over the signals compared.
 
 libcosim unloads FMU binaries when it is done, which pythonfmu's runtime does not survive
-within one process, so the run happens in a child process and only numbers come back.
+within one process, so each tool runs in a child process and only numbers come back.
 """
 
 from __future__ import annotations
 
+import math
 import multiprocessing as mp
+import tempfile
+import time
+import zipfile
+from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from orchestrator.errors import RunError
-from orchestrator.run import fmu_files
-from orchestrator.scenario import Scene
+from orchestrator.osp_export import export_osp
+from orchestrator.run import RunResult, run_scene
+from orchestrator.scenario import Scene, load_scene
+from orchestrator.ssp_export import export_ssp
+from orchestrator.ssp_import import load_ssp
+
+TOOLS = ("libcosim", "fmpy")
+#: the agreement ``mechcosim crosscheck`` requires
+REQUIRED = 1e-9
+#: crosscheck runs stop after this many macro steps unless a stop is given
+DEFAULT_MAX_STEPS = 5_000
 
 
-def run_with_libcosim(scene: Scene, cache_dir: Path | None = None) -> tuple[list[str], np.ndarray]:
-    """Recorded Real signals after each of libcosim's fixed steps (the start row is absent)."""
-    paths = fmu_files(scene, cache_dir)
+class ToolCannotRun(RunError):
+    """The tool cannot run this scene's system; the message says why, in one line."""
+
+
+@dataclass
+class ToolRun:
+    tool: str
+    via: str  # what the tool read: "SSP archive" or "OSP-IS file"
+    header: list[str]  # "time", then "<instance>.<variable>"
+    data: np.ndarray  # one row per communication point k = 1..n
+    wall_time: float
+    not_compared: dict[str, str] = field(default_factory=dict)  # signal -> why
+
+
+@dataclass
+class Agreement:
+    per_signal: dict[str, float]  # relative agreement of each signal compared
+    points: int  # communication points compared
+
+    @property
+    def worst(self) -> tuple[str, float]:
+        name = max(self.per_signal, key=self.per_signal.__getitem__)
+        return name, self.per_signal[name]
+
+
+def grid_steps(scene: Scene, until: float) -> int:
+    """Whole macro steps of the scene's master from its start to ``until``."""
+    return int(math.floor((until - scene.start) / scene.master.step + 1e-9))
+
+
+def cannot_run(scene: Scene, tool: str) -> str | None:
+    """Why ``tool`` cannot run ``scene``'s exported system (None: it can)."""
+    if tool == "libcosim":
+        step_ns = scene.master.step * 1e9
+        if abs(step_ns - round(step_ns)) > 1e-9 * max(1.0, step_ns) or round(step_ns) < 1:
+            return f"libcosim steps in whole nanoseconds; {scene.master.step!r} s is not one"
+        for c in scene.connections:
+            for instance, var in (c.source, c.target):
+                if scene.fmus[instance].model.variables[var].type == "Enumeration":
+                    return (
+                        f"libcosim ignores FMI 2.0 Enumeration variables, so it cannot make "
+                        f"the connection {c.source[0]}.{c.source[1]} -> "
+                        f"{c.target[0]}.{c.target[1]}"
+                    )
+    for c in scene.connections:
+        kind = scene.fmus[c.source[0]].model.variables[c.source[1]].type
+        if kind == "String":
+            return f"{tool}: String connections are not crosschecked ({c.source[0]}.{c.source[1]})"
+    return None
+
+
+def run_tool(
+    scene: Scene,
+    tool: str,
+    steps: int,
+    workdir: Path,
+    via: str = "ssp",
+    cache_dir: Path | None = None,
+) -> ToolRun:
+    """Export ``scene`` into ``workdir`` and run ``steps`` fixed macro steps of it in ``tool``
+    (libcosim from the SSP archive or, with ``via="osp"``, the OSP-IS file)."""
+    why = cannot_run(scene, tool)
+    if why is not None:
+        raise ToolCannotRun(why)
+    if tool == "fmpy":
+        via = "ssp"  # FMPy reads SSP archives, not OSP-IS files
+    workdir = Path(workdir)
+    record = [list(signal) for signal in scene.record]
+    types = {f"{i}.{v}": scene.fmus[i].model.variables[v].type for i, v in scene.record}
+    if via == "osp":
+        source = export_osp(scene, workdir / "osp", cache_dir)
+        what = "OSP-IS file"
+    else:
+        archive = export_ssp(scene, workdir / f"{scene.name}.ssp", cache_dir)
+        what = "SSP archive"
+        source = archive
+        if tool == "libcosim":  # libcosim reads an unpacked archive
+            source = workdir / "ssp"
+            with zipfile.ZipFile(archive) as z:
+                z.extractall(source)
+    not_compared: dict[str, str] = {}
+    if tool == "libcosim":
+        for name, kind in types.items():
+            if kind == "Enumeration":
+                not_compared[name] = "libcosim ignores FMI 2.0 Enumeration variables"
+    child = _libcosim_child if tool == "libcosim" else _fmpy_child
     job = {
-        "fmus": [
-            (name, str(paths[name]), spec.parameters, spec.inputs)
-            for name, spec in scene.fmus.items()
-        ],
-        "connections": [(c.source, c.target) for c in scene.connections],
-        "record": list(scene.record),
-        "step_ns": round(scene.master.step * 1e9),
-        "duration_ns": round((scene.stop - scene.start) * 1e9),
+        "source": str(source),
+        "record": [r for r in record if f"{r[0]}.{r[1]}" not in not_compared],
+        "steps": steps,
+        "start": scene.start,
+        "step": scene.master.step,
+        "stop": scene.stop,
     }
-    if abs(job["step_ns"] * 1e-9 - scene.master.step) > 1e-15 * max(1.0, scene.master.step):
-        raise RunError(f"libcosim steps in whole nanoseconds; {scene.master.step} s is not one")
+    started = time.perf_counter()
     with mp.get_context("spawn").Pool(1) as pool:
-        header, rows = pool.apply(_libcosim_child, (job,))
-    return header, np.array(rows)
+        header, rows = pool.apply(child, (job,))
+    wall = time.perf_counter() - started
+    data = np.array(rows, dtype=float).reshape(len(rows), len(header))
+    return ToolRun(tool, what, header, data, wall, not_compared)
+
+
+def agreement(ours: RunResult, theirs: ToolRun, scene: Scene) -> Agreement:
+    """Compare at the communication points both have (our recorded rows on the grid)."""
+    times = ours.signal("time")
+    k = np.rint((times - scene.start) / scene.master.step).astype(int)
+    on_grid = (k >= 1) & (k <= len(theirs.data))
+    on_grid &= np.abs(times - (scene.start + k * scene.master.step)) <= 1e-9 * scene.master.step
+    rows = np.flatnonzero(on_grid)
+    per_signal: dict[str, float] = {}
+    for j, name in enumerate(theirs.header[1:], start=1):
+        a = ours.data[rows, ours.header.index(name)]
+        b = theirs.data[k[rows] - 1, j]
+        scale = max(float(np.max(np.abs(a), initial=0.0)), float(np.max(np.abs(b), initial=0.0)))
+        diff = float(np.max(np.abs(a - b), initial=0.0))
+        if not (math.isfinite(diff) and math.isfinite(scale)):
+            per_signal[name] = math.inf
+        else:
+            per_signal[name] = diff / scale if scale > 0 else 0.0
+    return Agreement(per_signal, len(rows))
+
+
+@dataclass
+class Outcome:
+    tool: str
+    run: ToolRun | None = None
+    agreement: Agreement | None = None
+    cannot_run: str | None = None  # why the tool cannot run the scene
+
+    @property
+    def ok(self) -> bool:
+        return self.agreement is not None and self.agreement.worst[1] <= REQUIRED
+
+
+@dataclass
+class Crosscheck:
+    scene: Scene  # as run: fixed-step Jacobi, stop on the last whole step compared
+    steps: int
+    ours_wall_time: float
+    outcomes: list[Outcome]
+
+    @property
+    def ok(self) -> bool:
+        return all(o.ok for o in self.outcomes)
+
+
+def crosscheck(
+    path: Path,
+    overrides: dict[str, Any] | None = None,
+    stop: str | float | None = None,
+    tools: tuple[str, ...] = TOOLS,
+    via: str = "ssp",
+    cache_dir: Path | None = None,
+) -> Crosscheck:
+    """Run the scene at ``path`` (an .ssp archive or a TOML scene) under our fixed-step
+    Jacobi master and in each of ``tools``, over whole macro steps up to ``stop`` (default:
+    the scene's stop, at most DEFAULT_MAX_STEPS steps), and compare."""
+    overrides = dict(overrides or {})
+    if stop is not None:
+        overrides["scene.stop"] = stop
+    scene = load_any(path, overrides, cache_dir)
+    steps = grid_steps(scene, scene.stop)
+    if stop is None:
+        steps = min(steps, DEFAULT_MAX_STEPS)
+    if steps < 1:
+        raise RunError(f"nothing to compare: less than one step of {scene.master.step!r} s")
+    overrides |= {
+        "master.algorithm": "jacobi",
+        "scene.stop": scene.start + steps * scene.master.step,
+    }
+    scene = load_any(path, overrides, cache_dir)
+    steps = grid_steps(scene, scene.stop)
+    outcomes = [Outcome(tool, cannot_run=cannot_run(scene, tool)) for tool in tools]
+    wall = math.nan
+    with tempfile.TemporaryDirectory(prefix="mechcosim-crosscheck-") as scratch:
+        if any(o.cannot_run is None for o in outcomes):
+            started = time.perf_counter()
+            ours = run_scene(
+                scene,
+                output_dir=Path(scratch) / "ours",
+                cache_dir=cache_dir,
+                show_progress=False,
+                compare_reference=False,
+            )
+            wall = time.perf_counter() - started
+            if ours.status != "completed":
+                raise RunError(f"our Jacobi run did not complete: {ours.message}")
+        for o in outcomes:
+            if o.cannot_run is None:
+                o.run = run_tool(scene, o.tool, steps, Path(scratch) / o.tool, via, cache_dir)
+                o.agreement = agreement(ours, o.run, scene)
+    return Crosscheck(scene, steps, wall, outcomes)
+
+
+def load_any(path: Path, overrides: dict[str, Any], cache_dir: Path | None = None) -> Scene:
+    if Path(path).suffix == ".ssp":
+        return load_ssp(path, overrides, cache_dir)
+    return load_scene(path, overrides, cache_dir)
+
+
+# -- the tools, each in a child process ---------------------------------------------------
 
 
 def _libcosim_child(job: dict) -> tuple[list[str], list[list[float]]]:
     from libcosimpy.CosimExecution import CosimExecution
     from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
     from libcosimpy.CosimObserver import CosimObserver
-    from libcosimpy.CosimSlave import CosimLocalSlave
 
     log_output_level(CosimLogLevel.ERROR)
-    execution = CosimExecution.from_step_size(job["step_ns"])
-    index, refs = {}, {}
-    for name, path, parameters, inputs in job["fmus"]:
-        index[name] = execution.add_local_slave(CosimLocalSlave(fmu_path=path, instance_name=name))
-        refs[name] = {v.name.decode(): v.reference for v in execution.slave_variables(index[name])}
-        for var, value in {**parameters, **inputs}.items():
-            execution.real_initial_value(index[name], refs[name][var], value)
-    for (src, out), (dst, inp) in job["connections"]:
-        execution.connect_real_variables(index[src], refs[src][out], index[dst], refs[dst][inp])
+    source = job["source"]
+    if source.endswith(".xml"):
+        execution = CosimExecution.from_osp_config_file(source)
+    else:
+        execution = CosimExecution.from_ssp_file(source)
     observer = CosimObserver.create_last_value()
     execution.add_observer(observer)
-    record = [(inst, var) for inst, var in job["record"]]
-    header = ["time", *(f"{i}.{v}" for i, v in record)]
+    index = {s.name.decode(): s.index for s in execution.slave_infos()}
+    variables = {
+        name: {v.name.decode(): v for v in execution.slave_variables(i)}
+        for name, i in index.items()
+    }
+    readers = []
+    for instance, var in job["record"]:
+        v = variables[instance][var]
+        # libcosim's variable types: 0 Real, 1 Integer, 2 Boolean, 3 String
+        read = {0: observer.last_real_values, 1: observer.last_integer_values}.get(v.type)
+        if read is None:
+            read = observer.last_boolean_values
+        readers.append((read, index[instance], v.reference))
+    header = ["time", *(f"{i}.{v}" for i, v in job["record"])]
     rows = []
-    n_steps = job["duration_ns"] // job["step_ns"]
-    for k in range(1, n_steps + 1):  # the observer holds values only after a step
+    for k in range(1, job["steps"] + 1):  # the observer holds values only after a step
         if not execution.step(1):
             raise RuntimeError(f"libcosim step {k} failed")
-        row = [k * job["step_ns"] * 1e-9]
-        for inst, var in record:
-            row.append(observer.last_real_values(index[inst], [refs[inst][var]])[0])
+        row = [job["start"] + k * job["step"]]
+        row.extend(float(read(slave, [ref])[0]) for read, slave, ref in readers)
         rows.append(row)
     return header, rows
+
+
+def _fmpy_child(job: dict) -> tuple[list[str], list[list[float]]]:
+    from fmpy import extract, read_model_description
+    from fmpy.fmi2 import FMU2Slave
+    from fmpy.ssp.ssd import read_ssd
+
+    archive = job["source"]
+    ssd = read_ssd(archive, validate=True)
+    unpacked = Path(extract(archive))
+    start, step = job["start"], job["step"]
+    slaves, variables = {}, {}
+    for component in ssd.system.elements:
+        fmu_file = str(unpacked / component.source)
+        md = read_model_description(fmu_file, validate=False)
+        slave = FMU2Slave(
+            guid=md.guid,
+            unzipDirectory=extract(fmu_file),
+            modelIdentifier=md.coSimulation.modelIdentifier,
+            instanceName=component.name,
+        )
+        slave.instantiate()
+        slave.setupExperiment(startTime=start, stopTime=job["stop"])
+        slave.enterInitializationMode()
+        variables[component.name] = {v.name: v for v in md.modelVariables}
+        slaves[component.name] = slave
+        for binding in component.parameterBindings:
+            for parameter_set in binding.parameterValues:
+                for p in parameter_set.parameters:
+                    var = variables[component.name][p.name]
+                    if p.type == "Real" and p.unit and var.unit and p.unit != var.unit:
+                        raise RuntimeError(
+                            f"{component.name}.{p.name} is bound in {p.unit}, the FMU "
+                            f"declares {var.unit}: this loop does not convert units"
+                        )
+                    _set(slave, var, p.value)
+        slave.exitInitializationMode()
+    wires = [
+        (c.startElement, c.startConnector, c.endElement, c.endConnector)
+        for c in ssd.system.connections
+    ]
+    held: dict[tuple[str, str], object] = {}
+
+    def read_sources() -> None:
+        for src, out, _, _ in wires:
+            held[(src, out)] = _get(slaves[src], variables[src][out])
+
+    def feed(instance: str) -> None:
+        for src, out, dst, inp in wires:
+            if dst == instance:
+                _set(slaves[dst], variables[dst][inp], held[(src, out)])
+
+    # Outputs with direct feedthrough depend on inputs: settle the initial exchange.
+    for _ in range(len(slaves) + 1):
+        read_sources()
+        for name in slaves:
+            feed(name)
+    read_sources()
+    record = [(slaves[i], variables[i][v]) for i, v in job["record"]]
+    header = ["time", *(f"{i}.{v}" for i, v in job["record"])]
+    rows = []
+    for k in range(1, job["steps"] + 1):
+        t = start + (k - 1) * step
+        for name, slave in slaves.items():  # Jacobi: all see the last point's outputs
+            feed(name)
+            slave.doStep(currentCommunicationPoint=t, communicationStepSize=step)
+        read_sources()
+        rows.append([start + k * step, *(float(_get(s, v)) for s, v in record)])
+    return header, rows
+
+
+def _get(slave, variable):  # noqa: ANN001, ANN202 - FMPy objects
+    ref = [variable.valueReference]
+    if variable.type == "Real":
+        return slave.getReal(ref)[0]
+    if variable.type in ("Integer", "Enumeration"):
+        return slave.getInteger(ref)[0]
+    return slave.getBoolean(ref)[0]
+
+
+def _set(slave, variable, value) -> None:  # noqa: ANN001 - FMPy objects
+    ref = [variable.valueReference]
+    if variable.type == "Real":
+        slave.setReal(ref, [float(value)])
+    elif variable.type in ("Integer", "Enumeration"):
+        slave.setInteger(ref, [int(value)])
+    elif variable.type == "Boolean":
+        truth = value if isinstance(value, bool) else str(value).strip().lower() in ("true", "1")
+        slave.setBoolean(ref, [truth])
+    else:
+        raise RuntimeError(f"cannot set {variable.name}: type {variable.type}")
