@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
 import tomllib
 from pathlib import Path
@@ -58,12 +59,33 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("scene", type=Path)
     p.add_argument("out", type=Path, help="the .ssp file to write")
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
+    p.add_argument(
+        "--osp",
+        type=Path,
+        metavar="DIR",
+        help="also write libcosim's OspSystemStructure.xml with the FMUs beside it into DIR",
+    )
     p.set_defaults(handler=_export)
 
     p = sub.add_parser(
-        "crosscheck", help="run a scene in libcosim too and compare with our Jacobi master"
+        "crosscheck",
+        help="run a scene's exported system in libcosim and FMPy at the master's fixed step "
+        "and compare with our Jacobi master (exit 1 unless they agree to 1e-9)",
     )
     p.add_argument("scene", type=Path)
+    p.add_argument("--tool", choices=["libcosim", "fmpy"], help="only this tool (default: both)")
+    p.add_argument(
+        "--via",
+        choices=["ssp", "osp"],
+        default="ssp",
+        help="what libcosim loads: the SSP archive (default) or the OSP-IS file",
+    )
+    p.add_argument(
+        "--stop",
+        help="simulated time to compare over, e.g. '2 ms' (default: the scene's stop, "
+        "at most 10000 macro steps)",
+    )
+    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
     p.set_defaults(handler=_crosscheck)
 
     p = sub.add_parser("precision", help="work–precision report: error against wall time")
@@ -274,33 +296,45 @@ def _validate(args: argparse.Namespace) -> int:
 
 
 def _export(args: argparse.Namespace) -> int:
+    from orchestrator.osp_export import export_osp
     from orchestrator.scenario import load_scene
     from orchestrator.ssp_export import export_ssp
 
     scene = load_scene(args.scene, _overrides(args.set))
     out = export_ssp(scene, args.out)
     print(f"{out}: {len(scene.fmus)} components, {len(scene.connections)} connections")
+    if args.osp is not None:
+        print(f"{export_osp(scene, args.osp)}: the FMUs beside it")
     return 0
 
 
 def _crosscheck(args: argparse.Namespace) -> int:
-    import numpy as np
+    from orchestrator.studies import crosscheck as cc
 
-    from orchestrator.run import run_scene
-    from orchestrator.scenario import load_scene
-    from orchestrator.studies.crosscheck import run_with_libcosim
-
-    scene = load_scene(args.scene, {"master.algorithm": "jacobi"})
-    ours = run_scene(scene, show_progress=False)
-    header, theirs = run_with_libcosim(scene)
-    columns = [ours.header.index(h) for h in header]
-    n = min(len(theirs), len(ours.data) - 1)
-    diff = np.abs(theirs[:n] - ours.data[1 : n + 1][:, columns])
-    for j, name in enumerate(header[1:], start=1):
-        print(f"  {name:28s} max |ours - libcosim| = {diff[:, j].max():.3e}")
-    worst = float(diff[:, 1:].max())
-    print(f"largest difference {worst:.3e} over {n} steps of {scene.master.step} s")
-    return 0 if worst <= 1e-9 else 1
+    tools = (args.tool,) if args.tool else cc.TOOLS
+    check = cc.crosscheck(args.scene, _overrides(args.set), args.stop, tools, args.via)
+    scene = check.scene
+    how = "as asked" if args.stop else f"the scene's stop, at most {cc.DEFAULT_MAX_STEPS} steps"
+    print(
+        f"{scene.name}: {check.steps} fixed steps of {scene.master.step!r} s to "
+        f"{scene.stop:.9g} s ({how}); required agreement {cc.REQUIRED:g}"
+    )
+    if not math.isnan(check.ours_wall_time):
+        print(f"  mechcosim Jacobi: {check.ours_wall_time:.2f} s")
+    for o in check.outcomes:
+        if o.cannot_run is not None:
+            print(f"  {o.tool} cannot run {scene.name}: {o.cannot_run}")
+            continue
+        name, worst = o.agreement.worst
+        print(
+            f"  {o.tool} ({o.run.via}): agreement {worst:.3e} (worst {name}) over "
+            f"{o.agreement.points} points, {len(o.agreement.per_signal)} signals, "
+            f"{o.run.wall_time:.2f} s: {'ok' if o.ok else 'NOT MET'}"
+        )
+        for signal, why in o.run.not_compared.items():
+            print(f"    not compared: {signal} ({why})")
+    print("  agreement: max over signals of max_k |ours - theirs| / max_k max(|ours|, |theirs|)")
+    return 0 if check.ok else 1
 
 
 def _precision(args: argparse.Namespace) -> int:

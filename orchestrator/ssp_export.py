@@ -28,8 +28,11 @@ OSP = "http://opensimulationplatform.com/SSP/OSPAnnotations"
 for _prefix, _uri in (("ssd", SSD), ("ssc", SSC), ("ssv", SSV), ("osp", OSP)):
     ET.register_namespace(_prefix, _uri)
 
-#: FMI variable types that an SSD connector names (an Enumeration would need the type's
-#: definition in the SSD too; its connector leaves the type to the FMU, as SSP allows).
+#: FMI variable types that an SSD connector names.  An Enumeration would need the type's
+#: definition in the SSD too, and libcosim refuses both an ssc:Enumeration connector and
+#: an untyped one; so an Enumeration variable gets a connector (untyped: the type is left
+#: to the FMU, as SSP allows) only when a connection or a value needs it.  SSP does not
+#: ask for a connector per variable.
 _CONNECTOR_TYPES = ("Real", "Integer", "Boolean", "String")
 _KINDS = ("parameter", "input", "output")  # FMI causalities that are SSD connector kinds
 _BASE_UNITS = ("kg", "m", "s", "A", "K", "mol", "cd", "rad")
@@ -48,6 +51,7 @@ def system_structure(scene: Scene, sources: dict[str, str]) -> ET.Element:
         system.set("description", scene.description)
     elements = ET.SubElement(system, _q(SSD, "Elements"))
     units: dict[str, tuple[tuple[tuple[str, int], ...], float]] = {}
+    wired = {end for c in scene.connections for end in (c.source, c.target)}
     for name, spec in scene.fmus.items():
         component = ET.SubElement(
             elements,
@@ -59,6 +63,9 @@ def system_structure(scene: Scene, sources: dict[str, str]) -> ET.Element:
         connectors = ET.SubElement(component, _q(SSD, "Connectors"))
         for var in spec.model.variables.values():
             if var.causality not in _KINDS:
+                continue
+            needed = (name, var.name) in wired or var.name in spec.parameters | spec.inputs
+            if var.type not in _CONNECTOR_TYPES and not needed:
                 continue
             connector = ET.SubElement(
                 connectors, _q(SSD, "Connector"), name=var.name, kind=var.causality

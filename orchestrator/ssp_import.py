@@ -19,6 +19,7 @@ from pathlib import Path
 from typing import Any
 
 from orchestrator.errors import ScenarioError
+from orchestrator.model_info import ModelInfo, ModelInfoError, base_of_unit_name, model_info
 from orchestrator.scenario import Scene, read_toml, scene_from_table
 from orchestrator.ssp_export import OSP, SSC, SSD, SSV
 
@@ -81,16 +82,23 @@ def scene_table(root: ET.Element, unpacked: Path) -> dict[str, Any]:
     raw: dict[str, Any] = {"scene": {"name": name}, "fmus": {}, "connections": []}
     if system.get("description"):
         raw["scene"]["description"] = system.get("description")
+    units = _unit_definitions(root)
     for component in system.iter(f"{{{SSD}}}Component"):
         inputs = {
             c.get("name") for c in component.iter(f"{{{SSD}}}Connector") if c.get("kind") == "input"
         }
-        entry: dict[str, Any] = {"fmu": str(unpacked / component.get("source", ""))}
+        fmu = unpacked / component.get("source", "")
+        entry: dict[str, Any] = {"fmu": str(fmu)}
         for parameter in component.iter(f"{{{SSV}}}Parameter"):
             value = _value(parameter)
-            if value is not None:
-                table = "inputs" if parameter.get("name") in inputs else "parameters"
-                entry.setdefault(table, {})[parameter.get("name")] = value
+            if value is None:
+                continue
+            name = parameter.get("name")
+            real = parameter.find(f"{{{SSV}}}Real")
+            if real is not None and real.get("unit"):
+                value = _in_declared_unit(fmu, name, value, real.get("unit"), units)
+            table = "inputs" if name in inputs else "parameters"
+            entry.setdefault(table, {})[name] = value
         raw["fmus"][component.get("name")] = entry
     for c in system.iter(f"{{{SSD}}}Connection"):
         raw["connections"].append(
@@ -110,6 +118,58 @@ def scene_table(root: ET.Element, unpacked: Path) -> dict[str, Any]:
         if fixed is not None and fixed.get("baseStepSize") is not None:
             raw["master"] = {"algorithm": "jacobi", "step": float(fixed.get("baseStepSize"))}
     return raw
+
+
+Unit = tuple[tuple[tuple[str, int], ...], float, float]  # base exponents, factor, offset
+
+
+def _unit_definitions(root: ET.Element) -> dict[str, Unit]:
+    """The SSD's own unit definitions (SSP 1.0, ssc:Unit with its ssc:BaseUnit)."""
+    units: dict[str, Unit] = {}
+    for unit in root.iter(f"{{{SSC}}}Unit"):
+        base = unit.find(f"{{{SSC}}}BaseUnit")
+        if unit.get("name") is None or base is None:
+            continue
+        exponents = tuple(
+            sorted((k, int(v)) for k, v in base.attrib.items() if k not in ("factor", "offset"))
+        )
+        exponents = tuple((k, v) for k, v in exponents if v)
+        factor = float(base.get("factor", "1"))
+        units[unit.get("name")] = (exponents, factor, float(base.get("offset", "0")))
+    return units
+
+
+def _in_declared_unit(
+    fmu: Path, name: str, value: float, unit: str, ssd_units: dict[str, Unit]
+) -> float:
+    """A bound Real value in the unit its FMU declares for the variable (SSP 1.0: a
+    parameter value's unit may differ from the connector's; the tool converts).  The scene
+    holds values in the declared units, which is what the FMU is given."""
+    try:
+        model = model_info(fmu)
+    except ModelInfoError:
+        return value  # the scene check names the unreadable FMU
+    var = model.variables.get(name)
+    if var is None or var.unit is None or var.unit == unit:
+        return value
+    source, target = _base(unit, ssd_units, model), _base(var.unit, ssd_units, model)
+    if source is None or target is None or source[0] != target[0]:
+        raise ScenarioError(
+            fmu.parent.parent / "SystemStructure.ssd",
+            name,
+            f"bound in {unit!r}, which cannot be converted to the FMU's unit {var.unit!r}",
+        )
+    in_base = value * source[1] + source[2]
+    return (in_base - target[2]) / target[1]
+
+
+def _base(unit: str, ssd_units: dict[str, Unit], model: ModelInfo) -> Unit | None:
+    if unit in ssd_units:
+        return ssd_units[unit]
+    if unit in model.unit_definitions:
+        return model.unit_definitions[unit]
+    known = base_of_unit_name(unit)
+    return None if known is None else (*known, 0.0)
 
 
 def _value(parameter: ET.Element) -> float | int | bool | str | None:

@@ -1,68 +1,249 @@
-"""Run a scene in libcosim (libcosimpy) at a fixed step: proof that our FMUs are standard.
+"""Run a scene's exported system in another tool at a fixed step and compare it with our
+Jacobi master: proof that the FMUs and the export are standard.
+
+The tools see only what ``mechcosim export`` writes:
+
+* ``libcosim`` (libcosimpy) loads the SSP archive (unpacked; the OSP annotation gives its
+  fixed-step algorithm and step) or the OSP-IS ``OspSystemStructure.xml`` and steps its
+  fixed-step algorithm (every FMU steps, then values are transferred: Jacobi).
+* ``fmpy`` reads the SSP archive with FMPy's SSD reader (which checks it against the SSP
+  schema) and steps FMPy's ``FMU2Slave`` instances in a fixed-step Jacobi loop of its own:
+  bound values set in initialization mode, the initial exchange settled once per instance,
+  then inputs held over each step.  (FMPy's ``simulate_ssp`` cannot stand in: it starts
+  every connection at 0.0 and writes 0.0 over input values bound in the SSD.)
+
+Agreement, per recorded signal, is ``max_k |ours_k - theirs_k| / max_k max(|ours_k|,
+|theirs_k|)`` over the common communication points k = 1..n (0 when both are zero
+throughout); the agreement of a run is the largest over the signals compared.
 
 libcosim unloads FMU binaries when it is done, which pythonfmu's runtime does not survive
-within one process, so the run happens in a child process and only numbers come back.
+within one process, so each tool runs in a child process (``tool_runs``) and only numbers
+come back.
 """
 
 from __future__ import annotations
 
+import math
 import multiprocessing as mp
+import tempfile
+import time
+import zipfile
+from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from orchestrator.errors import RunError
-from orchestrator.run import fmu_files
-from orchestrator.scenario import Scene
+from orchestrator.osp_export import export_osp
+from orchestrator.run import RunResult, run_scene
+from orchestrator.scenario import Scene, load_scene
+from orchestrator.ssp_export import export_ssp
+from orchestrator.ssp_import import load_ssp
+from orchestrator.studies.tool_runs import fmpy_run, libcosim_run
+
+TOOLS = ("libcosim", "fmpy")
+#: the agreement ``mechcosim crosscheck`` requires
+REQUIRED = 1e-9
+#: crosscheck runs stop after this many macro steps unless a stop is given
+DEFAULT_MAX_STEPS = 5_000
 
 
-def run_with_libcosim(scene: Scene, cache_dir: Path | None = None) -> tuple[list[str], np.ndarray]:
-    """Recorded Real signals after each of libcosim's fixed steps (the start row is absent)."""
-    paths = fmu_files(scene, cache_dir)
+class ToolCannotRun(RunError):
+    """The tool cannot run this scene's system; the message says why, in one line."""
+
+
+@dataclass
+class ToolRun:
+    tool: str
+    via: str  # what the tool read: "SSP archive" or "OSP-IS file"
+    header: list[str]  # "time", then "<instance>.<variable>"
+    data: np.ndarray  # one row per communication point k = 1..n
+    wall_time: float
+    not_compared: dict[str, str] = field(default_factory=dict)  # signal -> why
+
+
+@dataclass
+class Agreement:
+    per_signal: dict[str, float]  # relative agreement of each signal compared
+    points: int  # communication points compared
+
+    @property
+    def worst(self) -> tuple[str, float]:
+        name = max(self.per_signal, key=self.per_signal.__getitem__)
+        return name, self.per_signal[name]
+
+
+def grid_steps(scene: Scene, until: float) -> int:
+    """Whole macro steps of the scene's master from its start to ``until``."""
+    return int(math.floor((until - scene.start) / scene.master.step + 1e-9))
+
+
+def cannot_run(scene: Scene, tool: str) -> str | None:
+    """Why ``tool`` cannot run ``scene``'s exported system (None: it can)."""
+    if tool == "libcosim":
+        step_ns = scene.master.step * 1e9
+        if abs(step_ns - round(step_ns)) > 1e-6 or round(step_ns) < 1:  # round-off only
+            return f"libcosim steps in whole nanoseconds; {scene.master.step!r} s is not one"
+        for c in scene.connections:
+            for instance, var in (c.source, c.target):
+                if scene.fmus[instance].model.variables[var].type == "Enumeration":
+                    return (
+                        f"libcosim ignores FMI 2.0 Enumeration variables, so it cannot make "
+                        f"the connection {c.source[0]}.{c.source[1]} -> "
+                        f"{c.target[0]}.{c.target[1]}"
+                    )
+    for c in scene.connections:
+        kind = scene.fmus[c.source[0]].model.variables[c.source[1]].type
+        if kind == "String":
+            return f"{tool}: String connections are not crosschecked ({c.source[0]}.{c.source[1]})"
+    return None
+
+
+def run_tool(
+    scene: Scene,
+    tool: str,
+    steps: int,
+    workdir: Path,
+    via: str = "ssp",
+    cache_dir: Path | None = None,
+) -> ToolRun:
+    """Export ``scene`` into ``workdir`` and run ``steps`` fixed macro steps of it in ``tool``
+    (libcosim from the SSP archive or, with ``via="osp"``, the OSP-IS file)."""
+    why = cannot_run(scene, tool)
+    if why is not None:
+        raise ToolCannotRun(why)
+    if tool == "fmpy":
+        via = "ssp"  # FMPy reads SSP archives, not OSP-IS files
+    workdir = Path(workdir)
+    record = [list(signal) for signal in scene.record]
+    types = {f"{i}.{v}": scene.fmus[i].model.variables[v].type for i, v in scene.record}
+    if via == "osp":
+        source = export_osp(scene, workdir / "osp", cache_dir)
+        what = "OSP-IS file"
+    else:
+        archive = export_ssp(scene, workdir / f"{scene.name}.ssp", cache_dir)
+        what = "SSP archive"
+        source = archive
+        if tool == "libcosim":  # libcosim reads an unpacked archive
+            source = workdir / "ssp"
+            with zipfile.ZipFile(archive) as z:
+                z.extractall(source)
+    not_compared: dict[str, str] = {}
+    if tool == "libcosim":
+        for name, kind in types.items():
+            if kind == "Enumeration":
+                not_compared[name] = "libcosim ignores FMI 2.0 Enumeration variables"
+    child = libcosim_run if tool == "libcosim" else fmpy_run
     job = {
-        "fmus": [
-            (name, str(paths[name]), spec.parameters, spec.inputs)
-            for name, spec in scene.fmus.items()
-        ],
-        "connections": [(c.source, c.target) for c in scene.connections],
-        "record": list(scene.record),
-        "step_ns": round(scene.master.step * 1e9),
-        "duration_ns": round((scene.stop - scene.start) * 1e9),
+        "source": str(source),
+        "record": [r for r in record if f"{r[0]}.{r[1]}" not in not_compared],
+        "steps": steps,
+        "start": scene.start,
+        "step": scene.master.step,
+        "stop": scene.stop,
     }
-    if abs(job["step_ns"] * 1e-9 - scene.master.step) > 1e-15 * max(1.0, scene.master.step):
-        raise RunError(f"libcosim steps in whole nanoseconds; {scene.master.step} s is not one")
+    started = time.perf_counter()
     with mp.get_context("spawn").Pool(1) as pool:
-        header, rows = pool.apply(_libcosim_child, (job,))
-    return header, np.array(rows)
+        header, rows = pool.apply(child, (job,))
+    wall = time.perf_counter() - started
+    data = np.array(rows, dtype=float).reshape(len(rows), len(header))
+    return ToolRun(tool, what, header, data, wall, not_compared)
 
 
-def _libcosim_child(job: dict) -> tuple[list[str], list[list[float]]]:
-    from libcosimpy.CosimExecution import CosimExecution
-    from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
-    from libcosimpy.CosimObserver import CosimObserver
-    from libcosimpy.CosimSlave import CosimLocalSlave
+def agreement(ours: RunResult, theirs: ToolRun, scene: Scene) -> Agreement:
+    """Compare at the communication points both have (our recorded rows on the grid)."""
+    times = ours.signal("time")
+    k = np.rint((times - scene.start) / scene.master.step).astype(int)
+    on_grid = (k >= 1) & (k <= len(theirs.data))
+    on_grid &= np.abs(times - (scene.start + k * scene.master.step)) <= 1e-9 * scene.master.step
+    rows = np.flatnonzero(on_grid)
+    per_signal: dict[str, float] = {}
+    for j, name in enumerate(theirs.header[1:], start=1):
+        a = ours.data[rows, ours.header.index(name)]
+        b = theirs.data[k[rows] - 1, j]
+        scale = max(float(np.max(np.abs(a), initial=0.0)), float(np.max(np.abs(b), initial=0.0)))
+        diff = float(np.max(np.abs(a - b), initial=0.0))
+        if not (math.isfinite(diff) and math.isfinite(scale)):
+            per_signal[name] = math.inf
+        else:
+            per_signal[name] = diff / scale if scale > 0 else 0.0
+    return Agreement(per_signal, len(rows))
 
-    log_output_level(CosimLogLevel.ERROR)
-    execution = CosimExecution.from_step_size(job["step_ns"])
-    index, refs = {}, {}
-    for name, path, parameters, inputs in job["fmus"]:
-        index[name] = execution.add_local_slave(CosimLocalSlave(fmu_path=path, instance_name=name))
-        refs[name] = {v.name.decode(): v.reference for v in execution.slave_variables(index[name])}
-        for var, value in {**parameters, **inputs}.items():
-            execution.real_initial_value(index[name], refs[name][var], value)
-    for (src, out), (dst, inp) in job["connections"]:
-        execution.connect_real_variables(index[src], refs[src][out], index[dst], refs[dst][inp])
-    observer = CosimObserver.create_last_value()
-    execution.add_observer(observer)
-    record = [(inst, var) for inst, var in job["record"]]
-    header = ["time", *(f"{i}.{v}" for i, v in record)]
-    rows = []
-    n_steps = job["duration_ns"] // job["step_ns"]
-    for k in range(1, n_steps + 1):  # the observer holds values only after a step
-        if not execution.step(1):
-            raise RuntimeError(f"libcosim step {k} failed")
-        row = [k * job["step_ns"] * 1e-9]
-        for inst, var in record:
-            row.append(observer.last_real_values(index[inst], [refs[inst][var]])[0])
-        rows.append(row)
-    return header, rows
+
+@dataclass
+class Outcome:
+    tool: str
+    run: ToolRun | None = None
+    agreement: Agreement | None = None
+    cannot_run: str | None = None  # why the tool cannot run the scene
+
+    @property
+    def ok(self) -> bool:
+        return self.agreement is not None and self.agreement.worst[1] <= REQUIRED
+
+
+@dataclass
+class Crosscheck:
+    scene: Scene  # as run: fixed-step Jacobi, stop on the last whole step compared
+    steps: int
+    ours_wall_time: float
+    outcomes: list[Outcome]
+
+    @property
+    def ok(self) -> bool:
+        return all(o.ok for o in self.outcomes)
+
+
+def crosscheck(
+    path: Path,
+    overrides: dict[str, Any] | None = None,
+    stop: str | float | None = None,
+    tools: tuple[str, ...] = TOOLS,
+    via: str = "ssp",
+    cache_dir: Path | None = None,
+) -> Crosscheck:
+    """Run the scene at ``path`` (an .ssp archive or a TOML scene) under our fixed-step
+    Jacobi master and in each of ``tools``, over whole macro steps up to ``stop`` (default:
+    the scene's stop, at most DEFAULT_MAX_STEPS steps), and compare."""
+    overrides = dict(overrides or {})
+    if stop is not None:
+        overrides["scene.stop"] = stop
+    scene = load_any(path, overrides, cache_dir)
+    steps = grid_steps(scene, scene.stop)
+    if stop is None:
+        steps = min(steps, DEFAULT_MAX_STEPS)
+    if steps < 1:
+        raise RunError(f"nothing to compare: less than one step of {scene.master.step!r} s")
+    overrides |= {
+        "master.algorithm": "jacobi",
+        "scene.stop": scene.start + steps * scene.master.step,
+    }
+    scene = load_any(path, overrides, cache_dir)
+    steps = grid_steps(scene, scene.stop)
+    outcomes = [Outcome(tool, cannot_run=cannot_run(scene, tool)) for tool in tools]
+    wall = math.nan
+    with tempfile.TemporaryDirectory(prefix="mechcosim-crosscheck-") as scratch:
+        if any(o.cannot_run is None for o in outcomes):
+            started = time.perf_counter()
+            ours = run_scene(
+                scene,
+                output_dir=Path(scratch) / "ours",
+                cache_dir=cache_dir,
+                show_progress=False,
+                compare_reference=False,
+            )
+            wall = time.perf_counter() - started
+            if ours.status != "completed":
+                raise RunError(f"our Jacobi run did not complete: {ours.message}")
+        for o in outcomes:
+            if o.cannot_run is None:
+                o.run = run_tool(scene, o.tool, steps, Path(scratch) / o.tool, via, cache_dir)
+                o.agreement = agreement(ours, o.run, scene)
+    return Crosscheck(scene, steps, wall, outcomes)
+
+
+def load_any(path: Path, overrides: dict[str, Any], cache_dir: Path | None = None) -> Scene:
+    if Path(path).suffix == ".ssp":
+        return load_ssp(path, overrides, cache_dir)
+    return load_scene(path, overrides, cache_dir)

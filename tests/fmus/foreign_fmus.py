@@ -157,11 +157,13 @@ def fmi_headers_dir() -> Path:
     return Path(fmpy.__file__).resolve().parent / "c-code"
 
 
-def build_torsion_body(dest: Path, can_get_set_state: bool = True) -> Path:
-    """Compile TorsionBody and pack it as ``dest/TorsionBody[-nostate].fmu``; return its path.
+def build_torsion_body(dest: Path, can_get_set_state: bool = True, phi0_in_degrees=False) -> Path:
+    """Compile TorsionBody and pack it as ``dest/TorsionBody[-nostate][-deg].fmu``; return
+    its path.
 
     Every build gets a fresh GUID, compiled into the binary (which refuses to instantiate
-    with any other) and written into the model description.
+    with any other) and written into the model description.  ``phi0_in_degrees``: the
+    parameter ``body.phi0`` is declared (and taken) in ``deg``, not SI.
     """
     compiler = c_compiler()
     if compiler is None:
@@ -170,7 +172,8 @@ def build_torsion_body(dest: Path, can_get_set_state: bool = True) -> Path:
     dest = Path(dest)
     dest.mkdir(parents=True, exist_ok=True)
     guid = "{" + str(uuid.uuid4()) + "}"
-    target = dest / (MODEL_IDENTIFIER + ("" if can_get_set_state else "-nostate") + ".fmu")
+    name = MODEL_IDENTIFIER + ("" if can_get_set_state else "-nostate")
+    target = dest / (name + ("-deg" if phi0_in_degrees else "") + ".fmu")
 
     with tempfile.TemporaryDirectory(prefix="torsion_body_") as tmp:
         library = Path(tmp) / (MODEL_IDENTIFIER + suffix)
@@ -188,6 +191,7 @@ def build_torsion_body(dest: Path, can_get_set_state: bool = True) -> Path:
             f"-I{fmi_headers_dir()}",
             f'-DTORSION_BODY_GUID="{guid}"',
             *(["-DTORSION_BODY_FMU_STATE"] if can_get_set_state else []),
+            *(["-DTORSION_BODY_PHI0_DEG"] if phi0_in_degrees else []),
             str(TORSION_BODY_SOURCE),
             "-o",
             str(library),
@@ -199,7 +203,7 @@ def build_torsion_body(dest: Path, can_get_set_state: bool = True) -> Path:
                 f"compiling {TORSION_BODY_SOURCE.name} failed:\n{' '.join(command)}\n"
                 f"{result.stdout}{result.stderr}"
             )
-        xml = torsion_body_model_description(guid, can_get_set_state)
+        xml = torsion_body_model_description(guid, can_get_set_state, phi0_in_degrees)
         partial = target.with_suffix(".fmu.part")
         with zipfile.ZipFile(partial, "w", zipfile.ZIP_DEFLATED) as z:
             z.writestr("modelDescription.xml", xml)
@@ -209,8 +213,15 @@ def build_torsion_body(dest: Path, can_get_set_state: bool = True) -> Path:
     return target
 
 
-def torsion_body_model_description(guid: str, can_get_set_state: bool) -> bytes:
+def torsion_body_model_description(
+    guid: str, can_get_set_state: bool, phi0_in_degrees: bool = False
+) -> bytes:
     """modelDescription.xml of TorsionBody (FMI 2.0, co-simulation)."""
+    units = dict(UNITS)
+    variables = TORSION_BODY_VARIABLES
+    if phi0_in_degrees:
+        units["deg"] = {"rad": 1, "factor": math.pi / 180.0}
+        variables = tuple((*v[:4], "deg", *v[5:]) if v[0] == "body.phi0" else v for v in variables)
     root = ET.Element(
         "fmiModelDescription",
         fmiVersion="2.0",
@@ -231,7 +242,7 @@ def torsion_body_model_description(guid: str, can_get_set_state: bool) -> bytes:
         providesDirectionalDerivative="false",
     )
     unit_defs = ET.SubElement(root, "UnitDefinitions")
-    for name, exponents in UNITS.items():
+    for name, exponents in units.items():
         unit = ET.SubElement(unit_defs, "Unit", name=name)
         ET.SubElement(unit, "BaseUnit", {k: str(v) for k, v in exponents.items()})
     categories = ET.SubElement(root, "LogCategories")
@@ -240,9 +251,7 @@ def torsion_body_model_description(guid: str, can_get_set_state: bool) -> bytes:
 
     model_vars = ET.SubElement(root, "ModelVariables")
     index: dict[str, int] = {}
-    for i, (name, vr, type_, causality, unit, start, description) in enumerate(
-        TORSION_BODY_VARIABLES, start=1
-    ):
+    for i, (name, vr, type_, causality, unit, start, description) in enumerate(variables, start=1):
         index[name] = i
         attrs = {"name": name, "valueReference": str(vr), "description": description}
         attrs["causality"] = causality

@@ -13,6 +13,8 @@
  *   TORSION_BODY_GUID       string the instantiation token must equal (required)
  *   TORSION_BODY_FMU_STATE  if defined, fmi2Get/Set/FreeFMUstate copy the state; otherwise
  *                           they report fmi2Error (canGetAndSetFMUstate="false")
+ *   TORSION_BODY_PHI0_DEG   if defined, the parameter body.phi0 is in degrees (its declared
+ *                           unit "deg"), as tools that are not SI inside declare angles
  */
 
 #include <math.h>
@@ -78,12 +80,18 @@ static void log_message(Instance *inst, fmi2Status status, const char *category,
 
 static int is_parameter(fmi2ValueReference vr) { return vr <= VR_W0; }
 
+#ifdef TORSION_BODY_PHI0_DEG
+#define PHI0_TO_RAD (3.14159265358979323846 / 180.0)
+#else
+#define PHI0_TO_RAD 1.0
+#endif
+
 /* Outputs as a function of the current state and inputs.  Before the first step the body
    sits at its start values, so outputs track the parameters while they are being set. */
 static void update_outputs(Instance *inst) {
     fmi2Real *r = inst->s.r;
     if (inst->s.mode == MODE_INSTANTIATED || inst->s.mode == MODE_INITIALIZATION) {
-        r[VR_PHI] = r[VR_PHI0];
+        r[VR_PHI] = PHI0_TO_RAD * r[VR_PHI0];
         r[VR_W] = r[VR_W0];
     }
     r[VR_TAU] = -(r[VR_K] * (r[VR_PHI_IN] - r[VR_PHI]) + r[VR_D] * (r[VR_W_IN] - r[VR_W]));
