@@ -105,6 +105,9 @@ class RegimeAwareMaster:
         self.ratio = 0.0  # error ratio of the last corrected trial
         self.predicted: list[list[float]] = []  # end values the last corrected trial used
         self.left_row: list[float] | None = None  # values just before the last landed switch
+        self.located = False  # the last switch_time is an instant an FMU reported
+        #: switches this close are one instant (chattering guard, landing on a located switch)
+        self.instant = settings.control.settle_window * settings.event_tolerance
 
     # -- helpers ----------------------------------------------------------------------
     def snapshot(self) -> _Snapshot:
@@ -183,6 +186,7 @@ class RegimeAwareMaster:
         system = self.system
         after_regimes, after_ind = system.regimes(), system.indicators()
         best: float | None = None
+        reported: float | None = None  # the earliest instant an FMU reported
         g1 = system.stop_indicator()
         if g1 is not None and g1 <= 0.0 < before.stop:
             best = t + h * before.stop / (before.stop - g1)
@@ -192,6 +196,7 @@ class RegimeAwareMaster:
                 te = system.values[i][watch.t_event]
                 if t < te <= t + h * (1 + self.control.event_time_slack):
                     best = te if best is None else min(best, te)
+                    reported = te if reported is None else min(reported, te)
                     continue
                 if fired and te == t:
                     # Switched at the step start, on inputs that crossed by t: land on it
@@ -207,6 +212,7 @@ class RegimeAwareMaster:
                     best = te if best is None else min(best, te)
             if fired and best is None:
                 best = t + 0.5 * h
+        self.located = best is not None and best == reported
         return best
 
     def step_ratio(self, before: _Snapshot) -> float:
@@ -288,7 +294,7 @@ class RegimeAwareMaster:
                 stats.iterations += self.settle() - 1
                 stats.events += max(self.log_switches(t, before), 1)
                 recorder.row(system.record_row(t))  # values just after the switch
-                window = control.settle_window * cfg.event_tolerance
+                window = self.instant
                 same_instant = same_instant + 1 if h <= window else 0
                 if same_instant > cfg.max_events_per_step:
                     raise RunError(
@@ -323,7 +329,7 @@ class RegimeAwareMaster:
                 self.corrected_trial(t, h, before, state, [list(v) for v in self.system.values])
                 te = self.switch_time(t, h, before)
             if te is not None:
-                if t + h - te <= cfg.event_tolerance or h <= cfg.min_step:
+                if t + h - te <= self._landing_window() or h <= cfg.min_step:
                     ratio = self.step_ratio(before) if cfg.midpoint else 0.0
                     if ratio > 1.0 and h > cfg.min_step:
                         # The step onto the switch must pass the error test as well:
@@ -367,7 +373,7 @@ class RegimeAwareMaster:
         jump into the held inputs), and the corrected step's own switch time is returned
         (None if the correction moved the switch past the step end)."""
         cfg = self.cfg
-        if t + h - te > cfg.event_tolerance and h > cfg.min_step:
+        if t + h - te > self._landing_window() and h > cfg.min_step:
             return te
         crossed = [list(v) for v in self.system.values]  # the predictor across the switch
         h_left = te - t - 0.5 * cfg.event_tolerance
@@ -384,6 +390,13 @@ class RegimeAwareMaster:
             self.left_row = None
         self.corrected_trial(t, h, before, state, predicted, compare=crossed)
         return self.switch_time(t, h, before)
+
+    def _landing_window(self) -> float:
+        """How far before the step end a switch may be for the step to end on it: the
+        event tolerance, or for an instant an FMU located, one instant (retaking a step
+        moves the located instant by the retake's own rounding and held inputs, by a few
+        event tolerances; chasing that cost three trials a time for nothing measurable)."""
+        return self.instant if self.located else self.cfg.event_tolerance
 
     def _left_values(
         self, t: float, te: float, h: float, state: list[Any], before: _Snapshot
