@@ -26,6 +26,7 @@ that keep switching at one instant (chattering / Zeno) with a diagnosis.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Any
 
@@ -105,6 +106,8 @@ class RegimeAwareMaster:
         self.ratio = 0.0  # error ratio of the last corrected trial
         self.predicted: list[list[float]] = []  # end values the last corrected trial used
         self.left_row: list[float] | None = None  # values just before the last landed switch
+        self.predictor_end: tuple[float, float] | None = None  # (t, h) the FMUs are at
+        self.predictor_states: list[Any] | None = None  # just after the last predictor step
         self.located = False  # the last switch_time is an instant an FMU reported
         #: switches this close are one instant (chattering guard, landing on a located switch)
         self.instant = settings.control.settle_window * settings.event_tolerance
@@ -125,15 +128,29 @@ class RegimeAwareMaster:
         system = self.system
         for i in range(len(system.instances)):
             system.feed(i)
-        self._step_all(t, h)
+        self._step_all(t, h, keep=self.cfg.midpoint)
+        self.predictor_end = (t, h)
 
-    def _step_all(self, t: float, h: float) -> None:
+    def _step_all(
+        self, t: float, h: float, which: list[int] | None = None, keep: bool = False
+    ) -> None:
+        """Step the instances (those in ``which``) over [t, t+h] and exchange; with
+        ``keep``, their states just after the step are kept for the corrector."""
         system = self.system
-        for i in range(len(system.instances)):
+        which = range(len(system.instances)) if which is None else which
+        for i in which:
             system.step(i, t, h)
+        if keep:
+            self.free_predictor_states()
+            self.predictor_states = system.get_state()
         system.read_all()
         self.refresh()
-        self.stats.do_steps += len(system.instances)
+        self.stats.do_steps += len(which)
+
+    def free_predictor_states(self) -> None:
+        if self.predictor_states is not None:
+            self.system.free_state(self.predictor_states)
+            self.predictor_states = None
 
     def corrected_trial(
         self,
@@ -149,16 +166,28 @@ class RegimeAwareMaster:
         (against the predictor's values at t+h, ``compare``, by default ``predicted``)
         relative to the tolerance: the predictor's error estimate."""
         system = self.system
-        self._restore(state)  # the step-start outputs are read back as well
         self.predicted = predicted  # to retake this very step (see _left_values)
         start = before.values
+        feeds, retake = [], []
+        at_predictor = self.predictor_end == (t, h) and self.predictor_states is not None
         for i, inputs in enumerate(self.held_inputs):
             reals = [
                 0.5 * (start[s][k] + predicted[s][k]) if averaged else start[s][k]
                 for (s, k), averaged in inputs
             ]
-            system.feed(i, reals)
-        self._step_all(t, h)
+            feeds.append(reals)
+            # An FMU whose held inputs the correction leaves as they were would retake
+            # the predictor's very step: when it is at its end, it stays (a doStep fewer).
+            if not (at_predictor and _same(reals, [start[s][k] for (s, k), _ in inputs])):
+                retake.append(i)
+        # Back to the step start, those that stay to the end of their predictor step.
+        kept = self.predictor_states
+        system.set_state([state[i] if i in retake else kept[i] for i in range(len(feeds))])
+        self.stats.rollbacks += 1
+        self.predictor_end = None
+        for i in range(len(feeds)):
+            system.feed(i, feeds[i], before.ints)
+        self._step_all(t, h, retake)
         worst, tol = 0.0, self.cfg.tolerance
         values = system.values
         compare = predicted if compare is None else compare
@@ -279,6 +308,7 @@ class RegimeAwareMaster:
                     left = self._left_values(t, te, h, state, before)
             finally:
                 system.free_state(state)
+                self.free_predictor_states()
             t += h
             stats.steps += 1
             if te is None:
@@ -426,6 +456,7 @@ class RegimeAwareMaster:
         """Back to the step start (a rollback, not a rejection: the corrector's retake)."""
         self.system.set_state(state)
         self.stats.rollbacks += 1
+        self.predictor_end = None
 
     def _rollback(self, state: list[Any]) -> None:
         """Back to the step start after a rejected trial."""
@@ -437,6 +468,13 @@ class RegimeAwareMaster:
             return "no FMU"
         t, sub, a, b = self.recorder.events[-1]
         return f"FMU {sub!r} ({a} -> {b})"
+
+
+def _same(a: list[float], b: list[float]) -> bool:
+    """Bit for bit the same values (0.0 and -0.0 differ)."""
+    return all(
+        x == y and math.copysign(1.0, x) == math.copysign(1.0, y) for x, y in zip(a, b, strict=True)
+    )
 
 
 def run_regime_aware(
