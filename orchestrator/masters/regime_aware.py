@@ -6,7 +6,9 @@ be rolled back.  A trial step is accepted when
 * no FMU changed regime, fired an internal event or crossed an event indicator (outputs
   named ``ind_*``) inside it — otherwise the switching instant is located (from the FMU's
   reported ``t_event`` when it has one, else by secant/bisection on the indicator) and the
-  step is retaken to land on it within ``event_tolerance``; and
+  step is retaken to land on it within ``event_tolerance`` (on an instant an FMU reported,
+  within one instant, ``settle_window`` event tolerances: a retaken step moves the FMU's
+  located instant by its own rounding and held inputs); and
 * the coupling error estimate is within ``tolerance``.  With ``input_hold = "start"`` the
   inputs are held at their step-start values, and the estimate is how much the exchanged
   signals change over the step, relative to each signal's running scale (first order).
@@ -16,6 +18,9 @@ be rolled back.  A trial step is accepted when
   difference the correction makes to the exchanged outputs, i.e. the effect of the held
   inputs on the receivers, not the size of their change: a small change of a large
   torque that nearly cancels the receiver's drive is seen as the large effect it has.
+  An FMU whose held inputs the correction leaves bit for bit as they were (the train while
+  the verge flies free) is not stepped again: it is restored to its state just after the
+  predictor's step.
   Sampled inputs (a state taken at the step start) are never averaged.
 
 After a switch the master iterates the exchange at that instant to a fixed point (so an
