@@ -156,9 +156,12 @@ class CoupledSystem:
         for i in range(len(self.instances)):
             self.read(i)
 
-    def feed(self, i: int, reals: list[float] | None = None) -> None:
+    def feed(
+        self, i: int, reals: list[float] | None = None, ints: list[list[int]] | None = None
+    ) -> None:
         """Set instance i's inputs from the latest values read from its sources (its Real
-        inputs from ``reals`` instead, when given, in the order of ``feeds[i]``)."""
+        inputs from ``reals`` instead, when given, in the order of ``feeds[i]``; its Integer
+        inputs from ``ints``, values read like ``self.ints``, when given)."""
         feed = self.feeds[i]
         set_reals = self._set_reals[i]
         if set_reals is not None:
@@ -168,7 +171,7 @@ class CoupledSystem:
             set_reals(reals)
         set_ints = self._set_ints[i]
         if set_ints is not None:
-            ints = self.ints
+            ints = self.ints if ints is None else ints
             set_ints([ints[s][k] for s, k in feed.int_sources])
 
     def step(self, i: int, t: float, h: float) -> None:

@@ -6,7 +6,9 @@ be rolled back.  A trial step is accepted when
 * no FMU changed regime, fired an internal event or crossed an event indicator (outputs
   named ``ind_*``) inside it — otherwise the switching instant is located (from the FMU's
   reported ``t_event`` when it has one, else by secant/bisection on the indicator) and the
-  step is retaken to land on it within ``event_tolerance``; and
+  step is retaken to land on it within ``event_tolerance`` (on an instant an FMU reported,
+  within one instant, ``settle_window`` event tolerances: a retaken step moves the FMU's
+  located instant by its own rounding and held inputs); and
 * the coupling error estimate is within ``tolerance``.  With ``input_hold = "start"`` the
   inputs are held at their step-start values, and the estimate is how much the exchanged
   signals change over the step, relative to each signal's running scale (first order).
@@ -16,6 +18,9 @@ be rolled back.  A trial step is accepted when
   difference the correction makes to the exchanged outputs, i.e. the effect of the held
   inputs on the receivers, not the size of their change: a small change of a large
   torque that nearly cancels the receiver's drive is seen as the large effect it has.
+  An FMU whose held inputs the correction leaves bit for bit as they were (the train while
+  the verge flies free) is not stepped again: it is restored to its state just after the
+  predictor's step.
   Sampled inputs (a state taken at the step start) are never averaged.
 
 After a switch the master iterates the exchange at that instant to a fixed point (so an
@@ -26,6 +31,7 @@ that keep switching at one instant (chattering / Zeno) with a diagnosis.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Any
 
@@ -105,6 +111,11 @@ class RegimeAwareMaster:
         self.ratio = 0.0  # error ratio of the last corrected trial
         self.predicted: list[list[float]] = []  # end values the last corrected trial used
         self.left_row: list[float] | None = None  # values just before the last landed switch
+        self.predictor_end: tuple[float, float] | None = None  # (t, h) the FMUs are at
+        self.predictor_states: list[Any] | None = None  # just after the last predictor step
+        self.located = False  # the last switch_time is an instant an FMU reported
+        #: switches this close are one instant (chattering guard, landing on a located switch)
+        self.instant = settings.control.settle_window * settings.event_tolerance
 
     # -- helpers ----------------------------------------------------------------------
     def snapshot(self) -> _Snapshot:
@@ -122,15 +133,29 @@ class RegimeAwareMaster:
         system = self.system
         for i in range(len(system.instances)):
             system.feed(i)
-        self._step_all(t, h)
+        self._step_all(t, h, keep=self.cfg.midpoint)
+        self.predictor_end = (t, h)
 
-    def _step_all(self, t: float, h: float) -> None:
+    def _step_all(
+        self, t: float, h: float, which: list[int] | None = None, keep: bool = False
+    ) -> None:
+        """Step the instances (those in ``which``) over [t, t+h] and exchange; with
+        ``keep``, their states just after the step are kept for the corrector."""
         system = self.system
-        for i in range(len(system.instances)):
+        which = range(len(system.instances)) if which is None else which
+        for i in which:
             system.step(i, t, h)
+        if keep:
+            self.free_predictor_states()
+            self.predictor_states = system.get_state()
         system.read_all()
         self.refresh()
-        self.stats.do_steps += len(system.instances)
+        self.stats.do_steps += len(which)
+
+    def free_predictor_states(self) -> None:
+        if self.predictor_states is not None:
+            self.system.free_state(self.predictor_states)
+            self.predictor_states = None
 
     def corrected_trial(
         self,
@@ -146,16 +171,28 @@ class RegimeAwareMaster:
         (against the predictor's values at t+h, ``compare``, by default ``predicted``)
         relative to the tolerance: the predictor's error estimate."""
         system = self.system
-        self._restore(state)  # the step-start outputs are read back as well
         self.predicted = predicted  # to retake this very step (see _left_values)
         start = before.values
+        feeds, retake = [], []
+        at_predictor = self.predictor_end == (t, h) and self.predictor_states is not None
         for i, inputs in enumerate(self.held_inputs):
             reals = [
                 0.5 * (start[s][k] + predicted[s][k]) if averaged else start[s][k]
                 for (s, k), averaged in inputs
             ]
-            system.feed(i, reals)
-        self._step_all(t, h)
+            feeds.append(reals)
+            # An FMU whose held inputs the correction leaves as they were would retake
+            # the predictor's very step: when it is at its end, it stays (a doStep fewer).
+            if not (at_predictor and _same(reals, [start[s][k] for (s, k), _ in inputs])):
+                retake.append(i)
+        # Back to the step start, those that stay to the end of their predictor step.
+        kept = self.predictor_states
+        system.set_state([state[i] if i in retake else kept[i] for i in range(len(feeds))])
+        self.stats.rollbacks += 1
+        self.predictor_end = None
+        for i in range(len(feeds)):
+            system.feed(i, feeds[i], before.ints)
+        self._step_all(t, h, retake)
         worst, tol = 0.0, self.cfg.tolerance
         values = system.values
         compare = predicted if compare is None else compare
@@ -183,6 +220,7 @@ class RegimeAwareMaster:
         system = self.system
         after_regimes, after_ind = system.regimes(), system.indicators()
         best: float | None = None
+        reported: float | None = None  # the earliest instant an FMU reported
         g1 = system.stop_indicator()
         if g1 is not None and g1 <= 0.0 < before.stop:
             best = t + h * before.stop / (before.stop - g1)
@@ -192,6 +230,7 @@ class RegimeAwareMaster:
                 te = system.values[i][watch.t_event]
                 if t < te <= t + h * (1 + self.control.event_time_slack):
                     best = te if best is None else min(best, te)
+                    reported = te if reported is None else min(reported, te)
                     continue
                 if fired and te == t:
                     # Switched at the step start, on inputs that crossed by t: land on it
@@ -207,6 +246,7 @@ class RegimeAwareMaster:
                     best = te if best is None else min(best, te)
             if fired and best is None:
                 best = t + 0.5 * h
+        self.located = best is not None and best == reported
         return best
 
     def step_ratio(self, before: _Snapshot) -> float:
@@ -273,6 +313,7 @@ class RegimeAwareMaster:
                     left = self._left_values(t, te, h, state, before)
             finally:
                 system.free_state(state)
+                self.free_predictor_states()
             t += h
             stats.steps += 1
             if te is None:
@@ -288,7 +329,7 @@ class RegimeAwareMaster:
                 stats.iterations += self.settle() - 1
                 stats.events += max(self.log_switches(t, before), 1)
                 recorder.row(system.record_row(t))  # values just after the switch
-                window = control.settle_window * cfg.event_tolerance
+                window = self.instant
                 same_instant = same_instant + 1 if h <= window else 0
                 if same_instant > cfg.max_events_per_step:
                     raise RunError(
@@ -323,7 +364,7 @@ class RegimeAwareMaster:
                 self.corrected_trial(t, h, before, state, [list(v) for v in self.system.values])
                 te = self.switch_time(t, h, before)
             if te is not None:
-                if t + h - te <= cfg.event_tolerance or h <= cfg.min_step:
+                if t + h - te <= self._landing_window() or h <= cfg.min_step:
                     ratio = self.step_ratio(before) if cfg.midpoint else 0.0
                     if ratio > 1.0 and h > cfg.min_step:
                         # The step onto the switch must pass the error test as well:
@@ -367,7 +408,7 @@ class RegimeAwareMaster:
         jump into the held inputs), and the corrected step's own switch time is returned
         (None if the correction moved the switch past the step end)."""
         cfg = self.cfg
-        if t + h - te > cfg.event_tolerance and h > cfg.min_step:
+        if t + h - te > self._landing_window() and h > cfg.min_step:
             return te
         crossed = [list(v) for v in self.system.values]  # the predictor across the switch
         h_left = te - t - 0.5 * cfg.event_tolerance
@@ -384,6 +425,13 @@ class RegimeAwareMaster:
             self.left_row = None
         self.corrected_trial(t, h, before, state, predicted, compare=crossed)
         return self.switch_time(t, h, before)
+
+    def _landing_window(self) -> float:
+        """How far before the step end a switch may be for the step to end on it: the
+        event tolerance, or for an instant an FMU located, one instant (retaking a step
+        moves the located instant by the retake's own rounding and held inputs, by a few
+        event tolerances; chasing that cost three trials a time for nothing measurable)."""
+        return self.instant if self.located else self.cfg.event_tolerance
 
     def _left_values(
         self, t: float, te: float, h: float, state: list[Any], before: _Snapshot
@@ -413,6 +461,7 @@ class RegimeAwareMaster:
         """Back to the step start (a rollback, not a rejection: the corrector's retake)."""
         self.system.set_state(state)
         self.stats.rollbacks += 1
+        self.predictor_end = None
 
     def _rollback(self, state: list[Any]) -> None:
         """Back to the step start after a rejected trial."""
@@ -424,6 +473,13 @@ class RegimeAwareMaster:
             return "no FMU"
         t, sub, a, b = self.recorder.events[-1]
         return f"FMU {sub!r} ({a} -> {b})"
+
+
+def _same(a: list[float], b: list[float]) -> bool:
+    """Bit for bit the same values (0.0 and -0.0 differ)."""
+    return all(
+        x == y and math.copysign(1.0, x) == math.copysign(1.0, y) for x, y in zip(a, b, strict=True)
+    )
 
 
 def run_regime_aware(
