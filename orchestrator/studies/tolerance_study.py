@@ -118,6 +118,10 @@ def run_study(
     n = spec.samples if samples is None else samples
     if n < 1:
         raise ScenarioError("--samples", "", f"expected a positive number of samples, got {n}")
+    if workers is not None and workers < 1:
+        raise ScenarioError(
+            "--workers", "", f"expected a positive number of workers, got {workers}"
+        )
     out_dir = Path(output_dir or scene.output_dir / "study").resolve()
     out_dir.mkdir(parents=True, exist_ok=True)
     csv_path = out_dir / "samples.csv"
