@@ -65,8 +65,8 @@ def test_regime_log_and_outputs(default_run) -> None:
 def test_a_coarse_tolerance_stays_accurate(tmp_path, fmu_cache, default_run) -> None:
     # The verge takes the train's affine response and the train the escapement's affine
     # load, so the held coefficients vary slowly: even at tolerance 1e-2 the coupling error
-    # stays below the other errors (measured 1e-2: turns 5e-7, trajectory 5.8e-5, events
-    # 9.5e-7 s; 5e-4: 1.5e-5, 7.9e-5, 7.9e-7 s), for fewer steps.
+    # stays below the other errors (measured 1e-2: turns 1.3e-6, trajectory 5.7e-5, events
+    # 9.5e-7 s; 5e-4: 1.5e-5, 7.8e-5, 7.7e-7 s), for fewer steps.
     coarse = run(tmp_path, fmu_cache, "coarse", **{"master.tolerance": 1e-2})
     for r in (coarse, default_run):
         assert r.accuracy["headline_error.turns_to_arm"] < 1e-4
