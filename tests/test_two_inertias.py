@@ -110,15 +110,3 @@ def test_failed_run_keeps_what_it_recorded(tmp_path, fmu_cache) -> None:
     assert summary["status"] == "failed" and "exceeds" in summary["message"]
     twist = np.abs(result.signal("a.phi") - result.signal("b.phi"))
     assert twist.max() <= 0.03
-
-
-def test_agrees_with_libcosim_at_the_same_step(tmp_path, fmu_cache) -> None:
-    pytest.importorskip("libcosimpy")
-    from orchestrator.studies.crosscheck import run_with_libcosim
-
-    scene = load_scene(SCENE, {"master.algorithm": "jacobi", "scene.stop": "0.2 s"})
-    ours = run_scene(scene, output_dir=tmp_path / "ours", cache_dir=fmu_cache, show_progress=False)
-    header, theirs = run_with_libcosim(scene, cache_dir=fmu_cache)
-    columns = [ours.header.index(h) for h in header]
-    assert len(theirs) == len(ours.data) - 1
-    assert np.max(np.abs(theirs - ours.data[1:][:, columns])) < 1e-9

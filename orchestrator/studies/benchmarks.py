@@ -17,7 +17,7 @@ from orchestrator.fmu_instance import FmuInstance
 from orchestrator.run import run_scene
 from orchestrator.scenario import load_scene
 
-SCENARIOS = Path(__file__).resolve().parent.parent / "scenarios"
+SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
 
 
 def _best_per_call(fn: Callable[[int], None], n: int, repeats: int = 5) -> float:

@@ -23,7 +23,7 @@ from orchestrator.run import reference_of
 from orchestrator.scenario import load_scene
 from orchestrator.studies.jobs import Job, JobResult, run_jobs
 
-SUITE_DIR = Path(__file__).resolve().parent.parent / "scenarios" / "stability"
+SUITE_DIR = Path(__file__).resolve().parents[2] / "scenarios" / "stability"
 ENERGY_LIMIT = 0.05  # relative energy residual above which a run is called unstable
 STABILITY_MASTERS = ("regime-aware", "jacobi", "gauss-seidel")
 
