@@ -20,6 +20,7 @@ from pathlib import Path
 
 from orchestrator.run import fmu_files
 from orchestrator.scenario import Scene
+from orchestrator.ssp_export import libcosim_step
 
 OSP_IS = "http://opensimulationplatform.com/MSMI/OSPSystemStructure"
 FILE_NAME = "OspSystemStructure.xml"
@@ -35,7 +36,7 @@ def osp_system_structure(scene: Scene, sources: dict[str, str]) -> ET.Element:
     relative to the XML file."""
     root = ET.Element(_q("OspSystemStructure"), version="0.1")
     ET.SubElement(root, _q("StartTime")).text = repr(scene.start)
-    ET.SubElement(root, _q("BaseStepSize")).text = repr(scene.master.step)
+    ET.SubElement(root, _q("BaseStepSize")).text = libcosim_step(scene.master.step)
     ET.SubElement(root, _q("Algorithm")).text = "fixedStep"
     simulators = ET.SubElement(root, _q("Simulators"))
     for name, spec in scene.fmus.items():

@@ -115,8 +115,20 @@ def system_structure(scene: Scene, sources: dict[str, str]) -> ET.Element:
         annotations, _q(SSC, "Annotation"), type="com.opensimulationplatform"
     )
     algorithm = ET.SubElement(annotation, _q(OSP, "Algorithm"))
-    ET.SubElement(algorithm, _q(OSP, "FixedStepAlgorithm"), baseStepSize=repr(scene.master.step))
+    step = libcosim_step(scene.master.step)
+    ET.SubElement(algorithm, _q(OSP, "FixedStepAlgorithm"), baseStepSize=step)
     return root
+
+
+def libcosim_step(step: float) -> str:
+    """The macro step as written for libcosim.  libcosim keeps time in whole nanoseconds
+    and truncates what it reads (50 µs converted to 4.9999999999999996e-05 s would step
+    49999 ns), so a step within round-off of a whole number of nanoseconds is written as
+    that number."""
+    ns = round(step * 1e9)
+    if ns >= 1 and abs(step * 1e9 - ns) <= 1e-6:
+        return repr(ns / 1e9)
+    return repr(step)
 
 
 def _parameter(parent: ET.Element, var: Any, value: object) -> None:

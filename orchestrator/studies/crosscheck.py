@@ -23,6 +23,7 @@ come back.
 
 from __future__ import annotations
 
+import importlib.util
 import math
 import multiprocessing as mp
 import tempfile
@@ -82,6 +83,8 @@ def grid_steps(scene: Scene, until: float) -> int:
 def cannot_run(scene: Scene, tool: str) -> str | None:
     """Why ``tool`` cannot run ``scene``'s exported system (None: it can)."""
     if tool == "libcosim":
+        if importlib.util.find_spec("libcosimpy") is None:
+            return "libcosimpy is not installed (pip install libcosimpy)"
         step_ns = scene.master.step * 1e9
         if abs(step_ns - round(step_ns)) > 1e-6 or round(step_ns) < 1:  # round-off only
             return f"libcosim steps in whole nanoseconds; {scene.master.step!r} s is not one"

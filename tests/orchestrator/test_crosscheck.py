@@ -11,6 +11,7 @@ import pytest
 from orchestrator.cli import main
 from orchestrator.run import RunResult
 from orchestrator.scenario import load_scene
+from orchestrator.ssp_export import libcosim_step
 from orchestrator.studies.crosscheck import REQUIRED, ToolRun, agreement, cannot_run, crosscheck
 
 SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
@@ -105,3 +106,19 @@ def test_a_tool_that_cannot_run_the_scene_says_why_in_one_line(capsys) -> None:
         "  libcosim cannot run two_inertias: libcosim steps in whole nanoseconds; "
         "0.000100000000001 s is not one"
     ]
+
+
+def test_a_step_converted_from_microseconds_is_written_in_whole_nanoseconds() -> None:
+    """'50 us' is 4.9999999999999996e-05 s, which libcosim would truncate to 49999 ns and
+    so disagree by 5e-5; written as 5e-05 it steps 50000 ns."""
+    assert libcosim_step(4.9999999999999996e-05) == "5e-05"
+    assert libcosim_step(1e-6) == "1e-06"
+    assert libcosim_step(1.5e-10) == "1.5e-10"  # no whole nanosecond: left as it is
+    check = crosscheck(
+        SCENARIOS / "two_inertias.toml",
+        {"master.step": "50 us"},
+        stop=0.002,
+        tools=("libcosim",),
+    )
+    assert check.scene.master.step == 4.9999999999999996e-05
+    _assert_agrees(check, ("libcosim",))
