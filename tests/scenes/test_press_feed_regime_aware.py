@@ -92,6 +92,8 @@ def test_run1_four_regimes_in_every_cycle(runs):
         assert seq[-1] == OVERRUN
 
 
+# Run 2 under the regime-aware master takes about 17 s: a long validation run.
+@pytest.mark.slow
 def test_run2_finds_the_grazing_disengagements(runs):
     r, ref = runs("press_feed_run2.toml")
     assert r.status == "completed", r.message
