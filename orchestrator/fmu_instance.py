@@ -136,9 +136,6 @@ class FmuInstance:
     def get_integer(self, refs: list[int]) -> list[int]:
         return self.fmu.getInteger(refs)
 
-    def set_integer(self, refs: list[int], values: list[int]) -> None:
-        self.fmu.setInteger(refs, values)
-
     # Prepared transfers for the hot path: the reference and value arrays are built once
     # and the FMI function is called directly (fmpy builds both arrays on every call and
     # goes through its call logger; together about half the cost of a small transfer).

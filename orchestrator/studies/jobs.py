@@ -71,21 +71,16 @@ def run_job(job: Job) -> JobResult:
 def run_jobs(
     jobs: list[Job], workers: int | None = None, dask_address: str | None = None
 ) -> list[JobResult]:
-    """Run ``jobs`` in parallel and return their results in job order."""
-    if not jobs:
-        return []
+    """Run ``jobs`` in parallel and return their results in job order (a job that raised
+    raises here)."""
     for job in jobs:  # loading builds (or finds cached) FMUs: once, here, not in every worker
         load_scene(job.scene, job.overrides)
-    if dask_address:
-        from dask.distributed import Client
-
-        with Client(dask_address) as client:
-            futures = client.map(run_job, jobs, pure=False)
-            return client.gather(futures)
-    workers = workers or min(len(jobs), os.cpu_count() or 1)
-    # Spawned workers: pythonfmu's runtime must not inherit a parent's loaded FMUs.
-    with ProcessPoolExecutor(max_workers=workers, mp_context=mp.get_context("spawn")) as pool:
-        return list(pool.map(run_job, jobs))
+    results: list[JobResult | None] = [None] * len(jobs)
+    for k, outcome in iter_jobs(jobs, workers, dask_address):
+        if isinstance(outcome, Exception):
+            raise outcome
+        results[k] = outcome
+    return results  # type: ignore[return-value]  # every index was filled
 
 
 def _ignore_sigint() -> None:

@@ -78,42 +78,30 @@ def sweep_jobs(
     tolerances,
     start_hold_tolerances=(),
 ) -> list[Job]:
+    def job(overrides: dict, directory: str, label: str) -> Job:
+        # The study compares every run with one reference it computes itself.
+        return Job(
+            str(scene_path), overrides, str(out_dir / directory), label, compare_reference=False
+        )
+
     jobs = []
     for master in ("jacobi", "gauss-seidel"):
         for f in step_factors:
             h = scene.master.step * f
-            if h > scene.stop - scene.start:
-                continue
-            overrides = {"master.algorithm": master, "master.step": h}
-            jobs.append(
-                Job(
-                    str(scene_path),
-                    overrides,
-                    str(out_dir / f"{master}_h{h:.3e}"),
-                    master,
-                    compare_reference=False,
-                )
-            )
+            if h <= scene.stop - scene.start:
+                overrides = {"master.algorithm": master, "master.step": h}
+                jobs.append(job(overrides, f"{master}_h{h:.3e}", master))
     for master in TOLERANCE_MASTERS:
         for tol in tolerances:
             overrides = {"master.algorithm": master, "master.tolerance": tol}
-            jobs.append(
-                Job(
-                    str(scene_path),
-                    overrides,
-                    str(out_dir / f"{master}_tol{tol:.0e}"),
-                    master,
-                    compare_reference=False,
-                )
-            )
+            jobs.append(job(overrides, f"{master}_tol{tol:.0e}", master))
     for tol in start_hold_tolerances:
         overrides = {
             "master.algorithm": "regime-aware",
             "master.tolerance": tol,
             "master.input_hold": "start",
         }
-        out = str(out_dir / f"regime-aware-start_tol{tol:.0e}")
-        jobs.append(Job(str(scene_path), overrides, out, START_HOLD, compare_reference=False))
+        jobs.append(job(overrides, f"regime-aware-start_tol{tol:.0e}", START_HOLD))
     return jobs
 
 
