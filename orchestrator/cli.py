@@ -300,6 +300,9 @@ def _export(args: argparse.Namespace) -> int:
     from orchestrator.scenario import load_scene
     from orchestrator.ssp_export import export_ssp
 
+    if args.osp is not None and args.osp.exists() and not args.osp.is_dir():
+        print(f"error: --osp {args.osp}: is a file; expected a directory", file=sys.stderr)
+        return 2
     scene = load_scene(args.scene, _overrides(args.set))
     out = export_ssp(scene, args.out)
     print(f"{out}: {len(scene.fmus)} components, {len(scene.connections)} connections")

@@ -59,3 +59,13 @@ def test_export_command_writes_both(tmp_path: Path, capsys) -> None:
         if [v.get("name") for v in c.iter(_q("Variable"))] == ["impact_count", "impact_count"]
     ]
     assert len(impact) == 1  # the Integer connection is there
+
+
+def test_osp_path_that_is_a_file_is_refused_in_one_line(tmp_path: Path, capsys) -> None:
+    taken = tmp_path / "taken"
+    taken.write_text("")
+    scene = SCENARIOS / "two_inertias.toml"
+    code = main(["export", str(scene), str(tmp_path / "t.ssp"), "--osp", str(taken)])
+    err = capsys.readouterr().err
+    assert code == 2 and "expected a directory" in err and err.count("\n") == 1
+    assert not (tmp_path / "t.ssp").exists()  # nothing written before the refusal
