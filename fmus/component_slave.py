@@ -18,15 +18,22 @@ the last step, is refused with fmi2Discard and nothing changes: the instance sta
 Non-finite parameters fail initialization.  The reason goes to the FMU's log, which
 pythonfmu's runtime forwards to the host only when debug logging is on; a missing module,
 which ends instantiation before any logging, is also written to standard error.
+
+The runtime also corrupts the heap when a process exits with its library still loaded
+(see ``release_runtime_at_exit``); each instance arranges the remedy.
 """
 
 from __future__ import annotations
 
+import atexit
 import ctypes
 import importlib
 import math
+import os
 import sys
+import threading
 import traceback
+from pathlib import Path
 from typing import TYPE_CHECKING, Any, ClassVar
 
 from pythonfmu import Fmi2Causality, Fmi2Slave, Fmi2Variability, Integer, Real
@@ -75,6 +82,7 @@ class ComponentSlave(Fmi2Slave):
 
     def __init__(self, **kwargs: Any) -> None:
         super().__init__(**kwargs)
+        release_runtime_at_exit(self.resources)
         start, stop, step = self.default_run
         self.default_experiment = DefaultExperiment(start, stop, step)
         try:
@@ -243,3 +251,36 @@ def _component_class(path: str) -> type[Component]:
     module, name = path.rsplit(".", 1)
     package = __package__ + ".components" if __package__ else "components"
     return getattr(importlib.import_module(f"{package}.{module}"), name)
+
+
+_RUNTIMES_TO_RELEASE: set[str] = set()
+
+
+def release_runtime_at_exit(resources: str | None) -> None:
+    """Release pythonfmu's runtime of this FMU before the process exits.
+
+    The runtime (0.7, Linux) keeps its interpreter state in a static ``shared_ptr`` and
+    resets that pointer from a library destructor.  A library still loaded when the process
+    exits (FMPy's freeLibrary does not unload it) has its static destructors run first, so
+    the destructor then resets a freed pointer: the heap is corrupted and the exit aborts
+    now and then ("corrupted double-linked list").  Resetting it from Python's own exit
+    handlers, while everything is alive, leaves nothing for the destructors to free twice.
+    """
+    if not sys.platform.startswith("linux") or not resources:
+        return
+    for library in (Path(resources).parent / "binaries" / "linux64").glob("*.so"):
+        if str(library) not in _RUNTIMES_TO_RELEASE:
+            _RUNTIMES_TO_RELEASE.add(str(library))
+            atexit.register(_release_runtime, str(library))
+
+
+def _release_runtime(library: str) -> None:
+    # Only where the host owns the interpreter: a host that is not Python has the runtime
+    # finalize Python from a thread of its own, as part of that very release.
+    if threading.get_native_id() != os.getpid():
+        return
+    try:
+        runtime = ctypes.CDLL(library, mode=os.RTLD_NOLOAD | os.RTLD_NOW)
+    except OSError:
+        return  # unloaded already, its destructors run in order
+    runtime.finalizePythonInterpreter()
