@@ -117,6 +117,7 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--output", type=Path, help="directory (default runs/<scene>/sweep)")
     p.add_argument("--workers", type=int, help="local processes (default: one per core)")
     p.add_argument("--dask", metavar="ADDRESS", help="run the sweep on this Dask scheduler")
+    p.add_argument("--run-plots", action="store_true", help="draw each run's plot too")
     p.set_defaults(handler=_sweep)
 
     p = sub.add_parser(
@@ -368,7 +369,12 @@ def _sweep(args: argparse.Namespace) -> int:
     from orchestrator.studies.parameter_sweep import run_sweep
 
     result = run_sweep(
-        args.scene, args.output, args.workers, args.dask, _overrides(args.set) or None
+        args.scene,
+        args.output,
+        args.workers,
+        args.dask,
+        _overrides(args.set) or None,
+        run_plots=args.run_plots,
     )
     print((result.output_dir / "sweep.md").read_text())
     print(f"results in {result.output_dir} (sweep.csv, sweep.png, sweep.md)")

@@ -12,7 +12,7 @@ from __future__ import annotations
 import csv
 import math
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -45,8 +45,9 @@ def _slug(text: str) -> str:
     return re.sub(r"[^A-Za-z0-9]+", "_", text).strip("_") or "base"
 
 
-def sweep_jobs(scene_path: Path, scene: Scene, out_dir: Path) -> list[Job]:
-    """One job per (series, value), in series-major order."""
+def sweep_jobs(scene_path: Path, scene: Scene, out_dir: Path, run_plots: bool = False) -> list[Job]:
+    """One job per (series, value), in series-major order.  Each run writes its time series
+    and summary; its plot only with ``run_plots`` (drawing it can cost more than the run)."""
     spec = scene.sweep
     assert spec is not None
     jobs = []
@@ -54,7 +55,9 @@ def sweep_jobs(scene_path: Path, scene: Scene, out_dir: Path) -> list[Job]:
         for k, value in enumerate(spec.values):
             overrides = {**series.overrides, spec.parameter: value}
             run_dir = out_dir / f"{_slug(series.label)}_{k:03d}"
-            jobs.append(Job(str(scene_path), overrides, str(run_dir), series.label))
+            jobs.append(
+                Job(str(scene_path), overrides, str(run_dir), series.label, plots=run_plots)
+            )
     return jobs
 
 
@@ -64,6 +67,7 @@ def run_sweep(
     workers: int | None = None,
     dask_address: str | None = None,
     overrides: dict[str, Any] | None = None,
+    run_plots: bool = False,
 ) -> SweepResult:
     """Run the scene's sweep and write the CSV, PNG and Markdown tables."""
     scene_path = Path(scene_path)
@@ -72,9 +76,9 @@ def run_sweep(
         raise ScenarioError(scene_path, "sweep", "missing; the scene has no [sweep] table")
     out_dir = Path(output_dir or scene.output_dir / "sweep")
     out_dir.mkdir(parents=True, exist_ok=True)
-    jobs = sweep_jobs(scene_path, scene, out_dir)
+    jobs = sweep_jobs(scene_path, scene, out_dir, run_plots)
     if overrides:
-        jobs = [Job(j.scene, {**overrides, **j.overrides}, j.output_dir, j.label) for j in jobs]
+        jobs = [replace(j, overrides={**overrides, **j.overrides}) for j in jobs]
     results = run_jobs(jobs, workers=workers, dask_address=dask_address)
     quantities, units = _quantities(scene, results)
     si_values = scene.sweep.si_values * max(1, len(scene.sweep.series))

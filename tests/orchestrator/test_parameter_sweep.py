@@ -9,7 +9,7 @@ import pytest
 
 from orchestrator.errors import ScenarioError
 from orchestrator.scenario import load_scene
-from orchestrator.studies.parameter_sweep import run_sweep
+from orchestrator.studies.parameter_sweep import run_sweep, sweep_jobs
 
 SCENE = (Path(__file__).resolve().parents[2] / "scenarios" / "two_inertias.toml").read_text()
 SWEEP = """
@@ -54,6 +54,18 @@ def test_sweep_runs_every_value_of_every_series(tmp_path: Path, fmu_cache, monke
     for name in ("sweep.csv", "sweep.png", "sweep.md"):
         assert (tmp_path / "out" / name).stat().st_size > 0
     assert "coupling stiffness" in (tmp_path / "out" / "sweep.md").read_text()
+    # Each run keeps its data; its plot is drawn only when asked for (--run-plots).
+    runs = sorted(p for p in (tmp_path / "out").iterdir() if p.is_dir())
+    assert len(runs) == 6
+    assert all((run / "summary.json").is_file() for run in runs)
+    assert not [png for run in runs for png in run.glob("*.png")]
+
+
+def test_run_plots_are_asked_for_per_job(tmp_path: Path) -> None:
+    path = write(tmp_path, SCENE + SWEEP)
+    scene = load_scene(path)
+    assert {j.plots for j in sweep_jobs(path, scene, tmp_path)} == {False}
+    assert {j.plots for j in sweep_jobs(path, scene, tmp_path, run_plots=True)} == {True}
 
 
 def test_unknown_swept_key_is_named(tmp_path: Path) -> None:
