@@ -79,9 +79,15 @@ def sweep_jobs(
     start_hold_tolerances=(),
 ) -> list[Job]:
     def job(overrides: dict, directory: str, label: str) -> Job:
-        # The study compares every run with one reference it computes itself.
+        # The study compares every run with one reference it computes itself, and draws
+        # one diagram of them all (a plot per run would cost more than most runs).
         return Job(
-            str(scene_path), overrides, str(out_dir / directory), label, compare_reference=False
+            str(scene_path),
+            overrides,
+            str(out_dir / directory),
+            label,
+            compare_reference=False,
+            plots=False,
         )
 
     jobs = []
