@@ -230,6 +230,27 @@ def _sweep_throughput(scene_file: str = "lever_rate_vs_load.toml") -> list[tuple
     ]
 
 
+def _press_feed_at_budget(budget: float = 1e-3) -> tuple[str, float, str]:
+    """Press feed Run 1 at trajectory error <= budget against its reference: the scene as
+    written (Gauss-Seidel at 0.1 ms, for information), then the regime-aware master from
+    the loosest tolerance until one run is within the budget."""
+    wall, err, result = _cosim("press_feed_run1.toml", {}, "", None)
+    print(f"press feed Run 1 as written: {wall:.2f} s, trajectory error {err:.1e}")
+    for tol in (1e-3, 3e-4, 2e-4, 1e-4, 3e-5):
+        overrides = {"master.algorithm": "regime-aware", "master.tolerance": tol}
+        wall, err, result = _cosim("press_feed_run1.toml", overrides, "", None)
+        t_ref = result.accuracy["reference_wall_time"]
+        print(f"  regime-aware at {tol:g}: {wall:.2f} s, trajectory error {err:.1e}")
+        if err <= budget:
+            break
+    return (
+        f"press feed Run 1 (regime-aware at {tol:g}, error {err:.1e}) / its reference "
+        f"({t_ref:.2f} s)",
+        wall / t_ref,
+        "<= 2",
+    )
+
+
 def _same_rows(a: list[dict], b: list[dict]) -> bool:
     """The sweep tables agree in every quantity (wall times aside)."""
 
@@ -262,14 +283,12 @@ def speed() -> None:
             print(f"  regime-aware at {master_tol:g}: {wall:.2f} s, turns error {err:.1e}")
         rows.append((f"{name}: co-simulation (1e-2) / monolithic", walls[1e-2] / t_mono, "<= 2"))
         rows.append((f"{name}: regime-aware 5e-4 / 1e-2", walls[5e-4] / walls[1e-2], ">= 3"))
-    wall, err, result = _cosim("press_feed_run1.toml", {}, "", None)
-    t_ref = result.accuracy["reference_wall_time"]
-    print(f"press feed Run 1: {wall:.2f} s, trajectory error {err:.1e}; reference {t_ref:.2f} s")
-    rows.append(("press feed Run 1: co-simulation / monolithic", wall / t_ref, "<= 2"))
+    rows.append(_press_feed_at_budget())
     rows.extend(_sweep_throughput())
-    print(f"\n{'ratio':58s} {'measured':>9s} {'target':>7s}")
+    width = max(len(what) for what, _, _ in rows)
+    print(f"\n{'ratio':{width}s} {'measured':>9s} {'target':>7s}")
     for what, ratio, target in rows:
-        print(f"{what:58s} {ratio:9.2f} {target:>7s}")
+        print(f"{what:{width}s} {ratio:9.2f} {target:>7s}")
     print("all times measured in this run, on this machine")
 
 
