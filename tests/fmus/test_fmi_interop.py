@@ -106,7 +106,9 @@ def assert_matches_reference(result, step: float = 1e-3) -> None:
 def test_c_fmu_in_a_scene_matches_the_hand_written_reference(tmp_path, foreign) -> None:
     scene = load_scene(write_scene(tmp_path, foreign_scene(str(foreign / "TorsionBody.fmu"))))
     assert scene.fmus["c"].component is None and not scene.fmus["c"].model.annotated
-    assert_matches_reference(run_scene(scene, output_dir=tmp_path / "run", show_progress=False))
+    assert_matches_reference(
+        run_scene(scene, output_dir=tmp_path / "run", show_progress=False, plots=False)
+    )
 
 
 @needs_cc
@@ -114,7 +116,9 @@ def test_container_fmu_in_a_scene_matches_the_same_reference(tmp_path, foreign) 
     fmu = foreign / "TorsionBody-container.fmu"
     scene = load_scene(write_scene(tmp_path, foreign_scene(str(fmu))))
     assert "FMPy" in scene.fmus["c"].model.generation_tool or scene.fmus["c"].model.variables
-    assert_matches_reference(run_scene(scene, output_dir=tmp_path / "run", show_progress=False))
+    assert_matches_reference(
+        run_scene(scene, output_dir=tmp_path / "run", show_progress=False, plots=False)
+    )
 
 
 @needs_cc
@@ -130,7 +134,7 @@ def test_dotted_names_work_in_overrides(tmp_path, foreign) -> None:
 def test_regime_aware_master_steps_a_black_box_with_rollback(tmp_path, foreign) -> None:
     path = write_scene(tmp_path, foreign_scene(str(foreign / "TorsionBody.fmu"), "regime-aware"))
     scene = load_scene(path, {"master.tolerance": 1e-2, "master.step": "0.1 ms"})
-    r = run_scene(scene, output_dir=tmp_path / "run", show_progress=False)
+    r = run_scene(scene, output_dir=tmp_path / "run", show_progress=False, plots=False)
     assert r.status == "completed", r.message
     assert r.stats.rollbacks > 0
     # It cannot know which inputs are sampled states: it says so and holds them.
@@ -146,7 +150,7 @@ def test_regime_aware_master_steps_a_black_box_with_rollback(tmp_path, foreign) 
 @pytest.mark.parametrize("fmu", ["TorsionBody-nostate.fmu", "TorsionBody-container.fmu"])
 def test_regime_aware_master_says_what_it_gives_up_without_state(tmp_path, foreign, fmu) -> None:
     path = write_scene(tmp_path, foreign_scene(str(foreign / fmu), "regime-aware"))
-    r = run_scene(load_scene(path), output_dir=tmp_path / "run", show_progress=False)
+    r = run_scene(load_scene(path), output_dir=tmp_path / "run", show_progress=False, plots=False)
     (warning,) = r.stats.extra["warnings"]
     assert "'c' cannot save and restore its state" in warning and "fixed-step Jacobi" in warning
     assert_matches_reference(r)

@@ -92,7 +92,7 @@ def test_deg_parameter_is_exported_in_deg(scene_file: Path, tmp_path: Path) -> N
     assert base.get("rad") == "1" and float(base.get("factor")) == pytest.approx(math.pi / 180)
     # The FMU, given degrees, starts the body at PHI0 rad, under our master and in libcosim
     # (which takes bound values as they are, whatever their unit) reading the archive.
-    ours = run_scene(scene, output_dir=tmp_path / "ours", show_progress=False)
+    ours = run_scene(scene, output_dir=tmp_path / "ours", show_progress=False, plots=False)
     assert ours.signal("c.body.phi")[0] == pytest.approx(PHI0, rel=1e-15)
     check = crosscheck(scene_file, tools=("libcosim",))
     for o in check.outcomes:

@@ -15,7 +15,9 @@ STOP_AT_ONE_RADIAN = {"signal": "a.phi", "above": "1 rad"}
 
 def run(tmp_path, fmu_cache, **overrides):
     scene = load_scene(SCENE, overrides)
-    return run_scene(scene, output_dir=tmp_path / "run", cache_dir=fmu_cache, show_progress=False)
+    return run_scene(
+        scene, output_dir=tmp_path / "run", cache_dir=fmu_cache, show_progress=False, plots=False
+    )
 
 
 def test_error_follows_the_tolerance_with_inputs_held_at_the_step_start(

@@ -77,14 +77,14 @@ def test_exported_system_runs_here_bit_for_bit(scene_file: str, stop: float, tmp
     archive): every recorded signal equals the TOML scene's, bit for bit."""
     original = SCENARIOS / scene_file
     scene = load_scene(original, {"scene.stop": stop})
-    ours = run_scene(scene, output_dir=tmp_path / "toml", show_progress=False)
+    ours = run_scene(scene, output_dir=tmp_path / "toml", show_progress=False, plots=False)
     archive = export_ssp(scene, tmp_path / "system.ssp")
     master = tomllib.loads(original.read_text())["master"]
     record = [f"{i}.{v}" for i, v in scene.record]
     (tmp_path / "system.toml").write_text(_toml({"master": master, "output": {"record": record}}))
     imported = load_ssp(archive)
     assert imported.master == scene.master and imported.stop == scene.stop
-    theirs = run_scene(imported, output_dir=tmp_path / "ssp", show_progress=False)
+    theirs = run_scene(imported, output_dir=tmp_path / "ssp", show_progress=False, plots=False)
     assert theirs.status == ours.status == "completed"
     assert theirs.header == ours.header
     assert np.array_equal(theirs.data, ours.data)

@@ -46,7 +46,7 @@ def runs(fmu_cache, tmp_path_factory):
         if name not in done:
             scene = load_scene(SCENARIOS / name, REGIME_AWARE)
             out = tmp_path_factory.mktemp(scene.name)
-            result = run_scene(scene, out, cache_dir=fmu_cache, show_progress=False)
+            result = run_scene(scene, out, cache_dir=fmu_cache, show_progress=False, plots=False)
             done[name] = (result, reference_of(scene))
         return done[name]
 
@@ -136,7 +136,9 @@ def test_run1_error_shrinks_with_the_tolerance(fmu_cache, tmp_path):
             SCENARIOS / "press_feed_run1.toml",
             {"master.algorithm": "regime-aware", "master.tolerance": tol},
         )
-        r = run_scene(scene, tmp_path / f"{tol:.0e}", cache_dir=fmu_cache, show_progress=False)
+        r = run_scene(
+            scene, tmp_path / f"{tol:.0e}", cache_dir=fmu_cache, show_progress=False, plots=False
+        )
         errors.append((r.accuracy["trajectory_error"], r.accuracy["event_time_error"]))
     for coarse, fine in zip(errors, errors[1:], strict=False):
         assert fine[0] < coarse[0] / 2 and fine[1] < coarse[1], errors

@@ -20,7 +20,9 @@ SCENE = Path(__file__).resolve().parents[2] / "scenarios" / "two_inertias.toml"
 
 def run(tmp_path, fmu_cache, **overrides):
     scene = load_scene(SCENE, overrides)
-    return run_scene(scene, output_dir=tmp_path / "run", cache_dir=fmu_cache, show_progress=False)
+    return run_scene(
+        scene, output_dir=tmp_path / "run", cache_dir=fmu_cache, show_progress=False, plots=False
+    )
 
 
 def test_closed_form_conserves_momentum_and_oscillates() -> None:
