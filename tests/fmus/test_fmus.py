@@ -63,3 +63,24 @@ def test_many_instances_in_one_process(fmu_cache) -> None:
         fmu.do_step(0.0, 0.5)
         assert fmu.get("phi") == pytest.approx(0.5)
         fmu.close()
+
+
+def test_the_code_an_fmu_packs_follows_edits(tmp_path, monkeypatch) -> None:
+    # The import scan is kept per file version: an edit that adds an import is seen at once
+    # (same second, other size), and nothing is scanned again while nothing changes.
+    from types import SimpleNamespace
+
+    import fmus.build as build
+
+    monkeypatch.setattr(build, "COMPONENTS_DIR", tmp_path)
+    (tmp_path / "__init__.py").write_text("")
+    (tmp_path / "b.py").write_text("X = 1\n")
+    a = tmp_path / "a.py"
+    a.write_text("Y = 2\n")
+    wrapper = SimpleNamespace(component="components.a.A")
+    assert [p.name for p in build.component_modules(wrapper)] == ["__init__.py", "a.py"]
+    a.write_text("from .b import X\n")
+    assert [p.name for p in build.component_modules(wrapper)] == ["__init__.py", "a.py", "b.py"]
+    scans = build._relative_imports.cache_info().misses
+    build.component_modules(wrapper)
+    assert build._relative_imports.cache_info().misses == scans
