@@ -327,8 +327,8 @@ def test_a_failing_sample_is_kept_with_its_reason(tmp_path: Path, capsys) -> Non
 @pytest.mark.slow
 def test_m739_sample_that_jams_is_not_armed_with_the_reason(tmp_path: Path) -> None:
     text = (SCENARIOS / "m739_study.toml").read_text()
-    text = text.split("[study]")[0] + (
-        '[study]\nsamples = 1\nquantities = ["turns_to_arm"]\n\n[[study.inputs]]\n'
+    text = text.split("\n[study]\n")[0] + (  # the table, not "[study]" in a comment
+        '\n[study]\nsamples = 1\nquantities = ["turns_to_arm"]\n\n[[study.inputs]]\n'
         'key = "fmus.verge.parameters.mu1"\nvalues = [0.3]\n\n'
         "[study.limits.turns_to_arm]\nmax = 40\n"
     )
