@@ -217,7 +217,8 @@ def write_plot(result: StudyResult, path: Path) -> None:
         hist.set_ylabel("samples")
         cdf.set_xlabel(label)
         cdf.set_ylabel("cumulative fraction")
-        cdf.legend(fontsize="x-small", loc="upper left")
+        if len(y):  # no sample with a value: nothing to label
+            cdf.legend(fontsize="x-small", loc="upper left")
         ns, se, comparison, r2 = convergence(result, q)
         if ns:
             conv.loglog(ns, se, "o-", label="these samples, s/√N")
@@ -225,11 +226,11 @@ def write_plot(result: StudyResult, path: Path) -> None:
                 conv.loglog(ns, ses, ".--", label=f"{method} (on the fit, R² {r2:.2f})")
             conv.set_xticks(ns, [str(n) for n in ns])
             conv.minorticks_off()
+            conv.legend(fontsize="x-small")
         conv.set_xlabel("samples N")
         conv.set_ylabel(
             f"standard error of mean{' [' + unit + ']' if unit not in ('', '1') else ''}"
         )
-        conv.legend(fontsize="x-small")
         for ax in row:
             ax.grid(True, alpha=0.3)
     fig.suptitle(
