@@ -19,31 +19,31 @@ from components.clock_train_kinematics import (
 
 # A synthetic check geometry (the report has no numbers; the values below are derived from an
 # independent implementation of its equations): mesh 1 and a mirrored mesh 2 with beta2 = -0.3.
-NOTE_M1 = ClockMesh(1.0, 0.2, 0.8, 0.1, 0.03, 0.3, 0.2, 0.03, 16, 4)
-NOTE_M2 = ClockMesh(1.0, -0.3, 0.8, 0.1, 0.03, 0.3, 0.2, 0.03, 16, 4, mirrored=True)
+CHECK_M1 = ClockMesh(1.0, 0.2, 0.8, 0.1, 0.03, 0.3, 0.2, 0.03, 16, 4)
+CHECK_M2 = ClockMesh(1.0, -0.3, 0.8, 0.1, 0.03, 0.3, 0.2, 0.03, 16, 4, mirrored=True)
 MESHES = {"mesh1": M739_MESH1, "mesh2": M739_MESH2}
 
 
-def test_note_transition_values() -> None:
-    phi1t, phi2pt = NOTE_M1.transition()
+def test_check_geometry_transition_values() -> None:
+    phi1t, phi2pt = CHECK_M1.transition()
     assert phi1t == pytest.approx(0.266457, abs=1e-6)
     assert phi2pt == pytest.approx(3.025756, abs=1e-6)
     for phase in ("ror", "rof"):
-        assert NOTE_M1.speed_ratio(phi1t, phase) == pytest.approx(-3.999373, abs=1e-6)
-        assert NOTE_M1.driven_angle(phi1t, phase) == pytest.approx(phi2pt, abs=1e-12)
+        assert CHECK_M1.speed_ratio(phi1t, phase) == pytest.approx(-3.999373, abs=1e-6)
+        assert CHECK_M1.driven_angle(phi1t, phase) == pytest.approx(phi2pt, abs=1e-12)
     # mesh 2 (gear turning CW): phi2GT = -0.366457, psiT = -3.125756
-    assert NOTE_M2.driven_angle(-0.366457, "ror") == pytest.approx(-3.125756, abs=5e-6)
-    assert NOTE_M2.driven_angle(-0.366457, "rof") == pytest.approx(-3.125756, abs=5e-6)
+    assert CHECK_M2.driven_angle(-0.366457, "ror") == pytest.approx(-3.125756, abs=5e-6)
+    assert CHECK_M2.driven_angle(-0.366457, "rof") == pytest.approx(-3.125756, abs=5e-6)
 
 
-def test_note_second_derivatives() -> None:
+def test_check_geometry_second_derivatives() -> None:
     """Derived: d2phi2P/dphi1^2 jumps at the transition (-1.537 RoR, -3.037 RoF); X Z of the
     mesh-1 RoR inverse at phi1 = 0.27 is -0.021089."""
-    t = NOTE_M1.transition()[0]
-    assert NOTE_M1.ratio_derivative(t, "ror") == pytest.approx(-1.537, abs=1e-3)
-    assert NOTE_M1.ratio_derivative(t, "rof") == pytest.approx(-3.037, abs=1e-3)
-    y = NOTE_M1.driven_angle(0.27, "ror")
-    assert NOTE_M1.inverse_ratio_derivative(y, "ror") == pytest.approx(-0.021089, abs=1e-6)
+    t = CHECK_M1.transition()[0]
+    assert CHECK_M1.ratio_derivative(t, "ror") == pytest.approx(-1.537, abs=1e-3)
+    assert CHECK_M1.ratio_derivative(t, "rof") == pytest.approx(-3.037, abs=1e-3)
+    y = CHECK_M1.driven_angle(0.27, "ror")
+    assert CHECK_M1.inverse_ratio_derivative(y, "ror") == pytest.approx(-0.021089, abs=1e-6)
 
 
 def _inputs(mesh: ClockMesh, n: int = 40) -> np.ndarray:

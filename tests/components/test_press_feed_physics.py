@@ -203,7 +203,7 @@ def test_v9_nonlinear_cycle_periodicity(run1):
     assert f[2] == pytest.approx(f[1], rel=1e-5)
 
 
-def test_linearized_regime2_extremes_match_the_notes_reproduction(app_h):
+def test_linearized_regime2_extremes_match_an_independent_integration(app_h):
     # Derived (App. H's linearized model integrated here; not printed in the thesis): max windup
     # 0.0139 rad, q_max 0.0292 in in Regime 2 of App. H.
     cyc = app_h.cycles[0]
