@@ -325,9 +325,9 @@ def advance(
     end = h_total * (1.0 - 1e-14)
     h = h_try if h_try > 0.0 else _first_step(y, k1, control)
     h_next = h
+    h_min = max(_H_MIN_ABSOLUTE, _H_MIN_RELATIVE * h_total)
     while t < end:
         left = h_total - t
-        h_min = max(_H_MIN_ABSOLUTE, _H_MIN_RELATIVE * h_total)
         if t > 0.0 and left <= h_min:  # an event left a sliver below the time resolution
             break
         h = min(h, control.h_max)
@@ -375,13 +375,11 @@ def advance(
             t += h_step
             g0 = g1
             h = h_next
-            if accept is None:
-                k1 = step.k7
-                continue
             k1 = step.k7
-            accept(y, t)  # observes only: the mode is unchanged, so k7 stays valid
-            if getattr(model, "halted", False):
-                break
+            if accept is not None:
+                accept(y, t)  # observes only: the mode is unchanged, so k7 stays valid
+                if getattr(model, "halted", False):
+                    break
             continue
         y = y_best
         t += th_best

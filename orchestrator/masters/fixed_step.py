@@ -65,11 +65,19 @@ def run_fixed_step(
             return
 
 
-def _run(system, scene: Scene, recorder, stats, progress, sequential: bool) -> None:
-    settings: FixedStepSettings = scene.master.settings
+def run_fixed_step_scene(
+    system: CoupledSystem,
+    scene: Scene,
+    step: float,
+    recorder: Recorder,
+    stats: StepStats,
+    progress,
+    sequential: bool,
+) -> None:
+    """``run_fixed_step`` over the scene's span at its record interval."""
     run_fixed_step(
         system,
-        settings.step,
+        step,
         scene.start,
         scene.stop,
         scene.record_every,
@@ -78,6 +86,11 @@ def _run(system, scene: Scene, recorder, stats, progress, sequential: bool) -> N
         progress,
         sequential,
     )
+
+
+def _run(system, scene: Scene, recorder, stats, progress, sequential: bool) -> None:
+    settings: FixedStepSettings = scene.master.settings
+    run_fixed_step_scene(system, scene, settings.step, recorder, stats, progress, sequential)
 
 
 def run_jacobi(

@@ -37,7 +37,7 @@ from typing import Any
 
 from orchestrator.errors import RunError
 from orchestrator.master_settings import RegimeAwareSettings
-from orchestrator.masters.fixed_step import run_fixed_step
+from orchestrator.masters.fixed_step import run_fixed_step_scene
 from orchestrator.recorder import Recorder, RegimeLog, StepStats
 from orchestrator.scenario import Scene
 from orchestrator.system import CoupledSystem
@@ -496,16 +496,8 @@ def run_regime_aware(
             f"master.step = {scene.master.step:g} s (no error control, switches seen only "
             "at communication points)"
         )
-        run_fixed_step(
-            system,
-            scene.master.step,
-            scene.start,
-            scene.stop,
-            scene.record_every,
-            recorder,
-            stats,
-            progress,
-            sequential=False,
+        run_fixed_step_scene(
+            system, scene, scene.master.step, recorder, stats, progress, sequential=False
         )
         return
     master = RegimeAwareMaster(

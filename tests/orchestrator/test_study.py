@@ -362,43 +362,16 @@ def test_m739_study_of_8_samples_within_a_minute(tmp_path: Path) -> None:
 def test_sigint_stops_a_study_and_resume_finishes_it_identically(tmp_path: Path) -> None:
     path = scene_file(tmp_path, STUDY.replace("samples = 80", "samples = 24"))
     env = {**os.environ, "PYTHONUNBUFFERED": "1"}
+
+    def study(out: Path, *extra: str) -> list[str]:
+        return [sys.executable, "-m", "orchestrator.cli", "study", str(path), "--output",
+                str(out), "--no-progress", "--workers", "2", *extra]  # fmt: skip
+
     whole = tmp_path / "whole"
-    subprocess.run(
-        [
-            sys.executable,
-            "-m",
-            "orchestrator.cli",
-            "study",
-            str(path),
-            "--output",
-            str(whole),
-            "--no-progress",
-            "--workers",
-            "2",
-        ],
-        check=True,
-        env=env,
-        cwd=PROJECT,
-        capture_output=True,
-    )
+    subprocess.run(study(whole), check=True, env=env, cwd=PROJECT, capture_output=True)
     out = tmp_path / "cut"
     proc = subprocess.Popen(
-        [
-            sys.executable,
-            "-m",
-            "orchestrator.cli",
-            "study",
-            str(path),
-            "--output",
-            str(out),
-            "--no-progress",
-            "--workers",
-            "2",
-        ],
-        env=env,
-        cwd=PROJECT,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
+        study(out), env=env, cwd=PROJECT, stdout=subprocess.PIPE, stderr=subprocess.PIPE
     )
     csv_file = out / "samples.csv"
     deadline = time.monotonic() + 120
@@ -410,23 +383,5 @@ def test_sigint_stops_a_study_and_resume_finishes_it_identically(tmp_path: Path)
     assert proc.wait(timeout=120) == 130
     kept = csv_file.read_text().count("\n") - 1
     assert 3 <= kept < 24
-    subprocess.run(
-        [
-            sys.executable,
-            "-m",
-            "orchestrator.cli",
-            "study",
-            str(path),
-            "--output",
-            str(out),
-            "--no-progress",
-            "--workers",
-            "2",
-            "--resume",
-        ],
-        check=True,
-        env=env,
-        cwd=PROJECT,
-        capture_output=True,
-    )
+    subprocess.run(study(out, "--resume"), check=True, env=env, cwd=PROJECT, capture_output=True)
     assert csv_file.read_bytes() == (whole / "samples.csv").read_bytes()

@@ -26,7 +26,6 @@ from typing import Any
 
 import numpy as np
 
-from components.units import RPM_PER_RAD_S
 from components.verge_escapement import (
     FREE,
 )
@@ -37,6 +36,7 @@ from orchestrator.scenes.m739.report import (
     _names,
     _parameter,
     _why_not_armed,
+    escapement_arguments,
     escapement_figure,
     reference_from,
     save_figure,
@@ -96,18 +96,13 @@ def analyse(
 def reference(scene: Scene) -> Reference:
     """The monolithic clock-train S&A with the scene's physics, as the yardstick."""
     train, verge = _names(scene)
-    spin = _parameter(scene, train, "spin")
     signal, level, _ = _arming(scene, train)
     if signal != f"{train}.rotor_angle":
         raise ValueError(
             f"clock_train reference: arming must be scene.stop_when on {train}.rotor_angle"
         )
     result = run_clock_train(
-        mu=_parameter(scene, train, "mu"),
-        mu1=_parameter(scene, verge, "mu1"),
-        rpm=spin * RPM_PER_RAD_S,
-        e_rest=_parameter(scene, verge, "e_rest"),
-        t_stop=scene.stop,
+        **escapement_arguments(scene, train, verge),
         loss_model=int(_parameter(scene, train, "loss_model")),
         pivot_loads=_parameter(scene, train, "pivot_loads") == 1.0,
         mesh_phase=_parameter(scene, train, "mesh_phase"),

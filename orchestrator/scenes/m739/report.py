@@ -36,6 +36,17 @@ def _parameter(scene: Scene, instance: str, name: str) -> float:
     return scene.component_class(instance).variable(name).start
 
 
+def escapement_arguments(scene: Scene, train: str, verge: str) -> dict[str, float]:
+    """The arguments every verge-train monolithic model takes, from the scene's FMUs."""
+    return {
+        "mu": _parameter(scene, train, "mu"),
+        "mu1": _parameter(scene, verge, "mu1"),
+        "rpm": _parameter(scene, train, "spin") * RPM_PER_RAD_S,
+        "e_rest": _parameter(scene, verge, "e_rest"),
+        "t_stop": scene.stop,
+    }
+
+
 def _arming_angle(scene: Scene) -> float:
     cond = scene.stop_when
     return cond.threshold if cond is not None else M739.phi_cut
@@ -86,17 +97,12 @@ def _why_not_armed(scene: Scene, col: dict[str, np.ndarray], train: str) -> str:
 def reference(scene: Scene) -> Reference:
     """The monolithic M739 model with the scene's physics, as the yardstick."""
     train, verge = _names(scene)
-    spin = _parameter(scene, train, "spin")
     data = escapement_data(
         _parameter(scene, verge, "center_distance"),
         pallet_inertia=_parameter(scene, verge, "pallet_inertia"),
     )
     result = run_m739(
-        mu=_parameter(scene, train, "mu"),
-        mu1=_parameter(scene, verge, "mu1"),
-        rpm=spin * RPM_PER_RAD_S,
-        e_rest=_parameter(scene, verge, "e_rest"),
-        t_stop=scene.stop,
+        **escapement_arguments(scene, train, verge),
         indexing=int(_parameter(scene, train, "indexing")),
         data=data,
     )
