@@ -150,13 +150,17 @@ class FmuInstance:
 
         return call
 
+    def _transfer(self, direction: str, refs: list[int], integer: bool) -> tuple[Any, ...]:
+        """(FMI function, instance, value references, count, value buffer) of a prepared
+        fmi2Get*/fmi2Set* ``direction`` ("Get" or "Set") of ``refs``."""
+        n = len(refs)
+        function = self._function(f"fmi2{direction}{'Integer' if integer else 'Real'}")
+        buf = ((fmi2Integer if integer else fmi2Real) * n)()
+        return function, self.fmu.component, (fmi2ValueReference * n)(*refs), n, buf
+
     def getter(self, refs: list[int], integer: bool = False) -> Callable[[], list]:
         """A function that reads the values of ``refs`` (Integer ones with ``integer``)."""
-        n = len(refs)
-        vr = (fmi2ValueReference * n)(*refs)
-        buf = ((fmi2Integer if integer else fmi2Real) * n)()
-        call = self._function("fmi2GetInteger" if integer else "fmi2GetReal")
-        component = self.fmu.component
+        call, component, vr, n, buf = self._transfer("Get", refs, integer)
 
         def get() -> list:
             call(component, vr, n, buf)
@@ -166,11 +170,7 @@ class FmuInstance:
 
     def setter(self, refs: list[int], integer: bool = False) -> Callable[[list], None]:
         """A function that sets the values of ``refs`` (Integer ones with ``integer``)."""
-        n = len(refs)
-        vr = (fmi2ValueReference * n)(*refs)
-        buf = ((fmi2Integer if integer else fmi2Real) * n)()
-        call = self._function("fmi2SetInteger" if integer else "fmi2SetReal")
-        component = self.fmu.component
+        call, component, vr, n, buf = self._transfer("Set", refs, integer)
 
         def set_values(values: list) -> None:
             buf[:] = values
