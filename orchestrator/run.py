@@ -20,7 +20,6 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from tqdm import tqdm
 
 from fmus.build import build_fmu
 from orchestrator.accuracy import compare
@@ -30,6 +29,7 @@ from orchestrator.fmu_instance import file_sha256
 from orchestrator.interrupt import Interrupted, SignalGuard, catching_signals, signal_name
 from orchestrator.masters import MASTERS
 from orchestrator.output_lock import OutputLock
+from orchestrator.progress import ProgressBar
 from orchestrator.recorder import Recorder, StepStats
 from orchestrator.scenario import Scene
 from orchestrator.scenes import ANALYSES, PLOTS, REFERENCES
@@ -102,7 +102,7 @@ def _run_locked(
     meta = _metadata(scene, fmu_paths)
     status, message = "completed", ""
     notes: list[str] = []
-    bar = tqdm(
+    bar = ProgressBar(
         total=scene.stop - scene.start,
         unit="s(sim)",
         delay=1.0,  # only runs longer than a moment show a bar

@@ -26,10 +26,10 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from tqdm import tqdm
 
 from orchestrator.errors import ScenarioError
 from orchestrator.interrupt import catching_signals
+from orchestrator.progress import ProgressBar
 from orchestrator.scenario import Scene, load_scene
 from orchestrator.studies.jobs import Job, JobResult, iter_jobs
 from orchestrator.studies.sampling import draw, unit_points
@@ -159,7 +159,7 @@ def run_study(
     units: dict[str, str] = {}
     start = time.perf_counter()
     interrupted: int | None = None
-    bar = tqdm(
+    bar = ProgressBar(
         total=n, initial=len(done), unit="sample", disable=not show_progress, desc=scene.name
     )
     with catching_signals() as guard, open(csv_path, "a", newline="") as f:
