@@ -112,6 +112,9 @@ class Component:
     PORTS: ClassVar[dict[str, dict[str, str]]] = {}
     #: How get_state copies the component; None: the whole of it, pickled (always safe).
     SNAPSHOT: ClassVar[SnapshotPlan | None] = None
+    #: step() takes the inputs itself (as update_outputs does, idempotently) and computes
+    #: the outputs at its end, so inputs set just before a step need no update_outputs.
+    STEP_TAKES_INPUTS: ClassVar[bool] = False
 
     def __init__(self, **parameters: float) -> None:
         for var in self.VARIABLES:

@@ -82,6 +82,7 @@ class TrainComponent(Component):
     ``_outputs``; ``self._phys``, ``self._model`` and ``self._y`` hold the state.
     """
 
+    STEP_TAKES_INPUTS = True  # step() starts with _apply_inputs and ends with _outputs
     _PHYSICS: type
     _MODEL: type
     # The snapshot copies the mutable mode and state; the constants (and the memo of

@@ -758,6 +758,7 @@ class VergeEscapement(Component):
     # Cheap snapshot: the verge constants are immutable in use and shared; the regime
     # machine's mode, the held train response and the state vector are copied.
     SNAPSHOT = SnapshotPlan(lists=("_y",), objects={"_held": {}, "_core": {"train": "_held"}})
+    STEP_TAKES_INPUTS = True  # step() starts with _take_inputs and ends with _outputs
 
     REGIME_NAMES = REGIME_NAMES
     PORTS = {"escape_wheel": ESCAPE_WHEEL_PORT}

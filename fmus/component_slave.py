@@ -181,9 +181,10 @@ class ComponentSlave(Fmi2Slave):
             self._refuse(f"doStep at t = {current_time} refused: {refusal}")
             return False
         try:
-            if self._feedthrough_stale:
+            if self._feedthrough_stale and not self.model.STEP_TAKES_INPUTS:
                 self._refresh()
             self.model.step(current_time, step_size)
+            self._feedthrough_stale = False
         except Exception as exc:  # the FMU cannot go on: say why through the FMI logger
             self.log(
                 f"{type(exc).__name__}: {exc}\n{traceback.format_exc(limit=3)}", Fmi2Status.error
