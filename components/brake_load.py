@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import math
 
-from .base import COMMON_OUTPUTS, Component, ComponentError, Variable
+from .base import COMMON_OUTPUTS, Component, ComponentError, SnapshotPlan, Variable
 from .press_feed_data import APP_H_J_O5, LBF_IN, ROLLER_RADIUS
 
 REGIME_STICK = 0
@@ -66,6 +66,8 @@ class BrakeLoad(Component):
     REGIME_NAMES = REGIME_NAMES
 
     PORTS = {"shaft": {"angle": "angle", "speed": "speed", "torque": "torque"}}
+
+    SNAPSHOT = SnapshotPlan()  # its state is scalars: shared, not pickled
 
     VARIABLES = (
         Variable(

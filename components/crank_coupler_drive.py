@@ -22,7 +22,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from .base import COMMON_OUTPUTS, Component, ComponentError, Variable
+from .base import COMMON_OUTPUTS, Component, ComponentError, SnapshotPlan, Variable
 from .press_feed_data import (
     APP_H_FOURIER,
     COUPLER_DAMPING_FACTOR,
@@ -205,6 +205,9 @@ class CrankCouplerDrive(Component):
     REGIME_NAMES = REGIME_NAMES
 
     PORTS = {"rocker": {"angle": "angle", "speed": "speed", "torque": "torque"}}
+
+    # Its state is scalars and its model (DriveModel) is frozen: shared, not pickled.
+    SNAPSHOT = SnapshotPlan()
 
     VARIABLES = (
         Variable(

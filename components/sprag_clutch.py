@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .base import Component, ComponentError, Variable, common_outputs
+from .base import Component, ComponentError, SnapshotPlan, Variable, common_outputs
 from .press_feed_data import C_NL, K_SP, N_DAMP, TABLE4, SpragGeometry
 
 REGIME_OVERRUN = 0
@@ -244,6 +244,8 @@ class SpragClutch(Component):
         "outer": {"angle": "angle_outer", "speed": "speed_outer", "torque": "torque"},
         "inner": {"angle": "angle_inner", "speed": "speed_inner", "torque": "torque"},
     }
+
+    SNAPSHOT = SnapshotPlan()  # its state is scalars: shared, not pickled
 
     VARIABLES = (
         Variable(
