@@ -204,10 +204,23 @@ class CoupledSystem:
     def get_state(self) -> list[Any]:
         return [inst.get_state() for inst in self.instances]
 
-    def set_state(self, state: list[Any]) -> None:
+    def set_state(
+        self, state: list[Any], values: tuple[list[list[float]], list[list[int]]] | None = None
+    ) -> None:
+        """Restore every FMU and what was read from it: ``values``, the (Real, Integer)
+        values read when the states were saved, when the caller has them (reading again
+        gives the same numbers), else read again."""
+        self.restore(state)
+        if values is None:
+            self.read_all()
+        else:
+            self.values, self.ints = list(values[0]), list(values[1])
+
+    def restore(self, state: list[Any]) -> None:
+        """Restore every FMU without reading it (``values`` keep what was read before): for
+        a caller that feeds them given values and steps or reads them next."""
         for inst, s in zip(self.instances, state, strict=True):
             inst.set_state(s)
-        self.read_all()
 
     def free_state(self, state: list[Any]) -> None:
         for inst, s in zip(self.instances, state, strict=True):

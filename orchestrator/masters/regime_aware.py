@@ -114,6 +114,7 @@ class RegimeAwareMaster:
         self.predictor_end: tuple[float, float] | None = None  # (t, h) the FMUs are at
         self.predictor_states: list[Any] | None = None  # just after the last predictor step
         self.located = False  # the last switch_time is an instant an FMU reported
+        self.start_values: tuple[list[list[float]], list[list[int]]] = ([], [])
         #: switches this close are one instant (chattering guard, landing on a located switch)
         self.instant = settings.control.settle_window * settings.event_tolerance
 
@@ -187,7 +188,8 @@ class RegimeAwareMaster:
                 retake.append(i)
         # Back to the step start, those that stay to the end of their predictor step.
         kept = self.predictor_states
-        system.set_state([state[i] if i in retake else kept[i] for i in range(len(feeds))])
+        # Not read back: each is fed the values above, and read again after the step below.
+        system.restore([state[i] if i in retake else kept[i] for i in range(len(feeds))])
         self.stats.rollbacks += 1
         self.predictor_end = None
         for i in range(len(feeds)):
@@ -307,6 +309,7 @@ class RegimeAwareMaster:
                 h = min(h, target - t + 0.5 * cfg.event_tolerance)
             state = system.get_state()
             before = self.snapshot()  # consistent: every trial and settle ends refreshed
+            self.start_values = (before.values, before.ints)  # what the FMUs give at t
             try:
                 h, te = self._attempt(t, h, before, state)
                 if te is not None:
@@ -459,7 +462,7 @@ class RegimeAwareMaster:
 
     def _restore(self, state: list[Any]) -> None:
         """Back to the step start (a rollback, not a rejection: the corrector's retake)."""
-        self.system.set_state(state)
+        self.system.set_state(state, self.start_values)
         self.stats.rollbacks += 1
         self.predictor_end = None
 
