@@ -52,7 +52,7 @@ from functools import cache
 
 import numpy as np
 
-from .base import COMMON_OUTPUTS, Component, ComponentError, Variable
+from .base import COMMON_OUTPUTS, Component, ComponentError, SnapshotPlan, Variable
 from .clock_train_kinematics import M739_MESH1, M739_MESH2, ClockMesh
 from .m739_data import M739
 from .mesh_efficiency import (
@@ -302,6 +302,7 @@ class GearMesh(Component):
         "driven": {"angle": "driven_angle", "speed": "driven_speed", "torque": "load_torque"},
     }
 
+    SNAPSHOT = SnapshotPlan()  # scalars (and caches of parameters): shared, not pickled
     VARIABLES = (
         Variable(
             "model", "parameter", "1", MODEL_INVOLUTE,

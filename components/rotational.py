@@ -9,12 +9,13 @@ from __future__ import annotations
 
 import math
 
-from .base import COMMON_OUTPUTS, Component, ComponentError, Variable, common_outputs
+from .base import COMMON_OUTPUTS, Component, ComponentError, SnapshotPlan, Variable, common_outputs
 
 
 class Inertia(Component):
     """A rigid body on a frictionless pivot, driven by an input torque."""
 
+    SNAPSHOT = SnapshotPlan()  # scalars (and caches of parameters): shared, not pickled
     VARIABLES = (
         Variable("J", "parameter", "kg.m2", 1.0e-3, "moment of inertia", min=0.0),
         Variable("phi0", "parameter", "rad", 0.0, "initial angle"),
@@ -53,6 +54,7 @@ class SpringDamperInertia(Component):
     current inputs (direct feedthrough).
     """
 
+    SNAPSHOT = SnapshotPlan()  # scalars (and caches of parameters): shared, not pickled
     VARIABLES = (
         Variable("J", "parameter", "kg.m2", 1.0e-3, "moment of inertia", min=0.0),
         Variable("k", "parameter", "N.m/rad", 10.0, "torsional stiffness", min=0.0),

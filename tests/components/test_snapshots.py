@@ -8,9 +8,19 @@ from components.base import Component, SnapshotPlan
 from components.brake_load import BrakeLoad
 from components.crank_coupler_drive import CrankCouplerDrive
 from components.detached_lever import DetachedLever
+from components.gear_mesh import GearMesh
+from components.rotational import Inertia, SpringDamperInertia
 from components.sprag_clutch import SpragClutch
 
-SHARED = [CrankCouplerDrive, SpragClutch, BrakeLoad, DetachedLever]
+SHARED = [
+    CrankCouplerDrive,
+    SpragClutch,
+    BrakeLoad,
+    DetachedLever,
+    Inertia,
+    SpringDamperInertia,
+    GearMesh,
+]
 
 
 def immutable(value: object) -> bool:
