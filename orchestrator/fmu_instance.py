@@ -11,6 +11,7 @@ import atexit
 import hashlib
 import shutil
 from collections.abc import Callable
+from ctypes import byref
 from pathlib import Path
 from typing import Any
 
@@ -23,8 +24,10 @@ from fmpy.fmi2 import (  # the allocators fmpy itself hands to FMUs, and its val
     fmi2CallbackFreeMemoryTYPE,
     fmi2CallbackFunctions,
     fmi2CallbackLoggerTYPE,
+    fmi2FMUstate,
     fmi2Integer,
     fmi2Real,
+    fmi2True,
     fmi2ValueReference,
     free,
 )
@@ -74,6 +77,11 @@ class FmuInstance:
         self.fmu.instantiate(callbacks=self._callbacks, loggingOn=True)
         self._alive = True
         self._freeable = True
+        # The calls of every macro step, prepared like the transfers below.
+        self._do_step = self._function("fmi2DoStep")
+        self._get_state = self._function("fmi2GetFMUstate")
+        self._set_state = self._function("fmi2SetFMUstate")
+        self._free_state = self._function("fmi2FreeFMUstate")
 
     def _log(self, env: Any, instance: bytes, status: int, category: bytes, message: bytes) -> None:
         self.messages.append(message.decode("utf-8", "replace") if message else "")
@@ -115,7 +123,7 @@ class FmuInstance:
     def do_step(self, t: float, h: float) -> None:
         logged = len(self.messages)
         try:
-            self.fmu.doStep(t, h)
+            self._do_step(self.fmu.component, t, h, fmi2True)
         except FMICallException as exc:
             self._alive = False
             raise RunError(
@@ -184,13 +192,15 @@ class FmuInstance:
 
     # -- state ------------------------------------------------------------------------
     def get_state(self) -> Any:
-        return self.fmu.getFMUState()
+        state = fmi2FMUstate()
+        self._get_state(self.fmu.component, byref(state))
+        return state
 
     def set_state(self, state: Any) -> None:
-        self.fmu.setFMUState(state)
+        self._set_state(self.fmu.component, state)
 
     def free_state(self, state: Any) -> None:
-        self.fmu.freeFMUState(state)
+        self._free_state(self.fmu.component, byref(state))
 
     def close(self) -> None:
         if self.fmu is None:
