@@ -114,7 +114,6 @@ class RegimeAwareMaster:
         self.predictor_end: tuple[float, float] | None = None  # (t, h) the FMUs are at
         self.predictor_states: list[Any] | None = None  # just after the last predictor step
         self.located = False  # the last switch_time is an instant an FMU reported
-        self.start_values: tuple[list[list[float]], list[list[int]]] = ([], [])
         #: switches this close are one instant (chattering guard, landing on a located switch)
         self.instant = settings.control.settle_window * settings.event_tolerance
 
@@ -309,7 +308,6 @@ class RegimeAwareMaster:
                 h = min(h, target - t + 0.5 * cfg.event_tolerance)
             state = system.get_state()
             before = self.snapshot()  # consistent: every trial and settle ends refreshed
-            self.start_values = (before.values, before.ints)  # what the FMUs give at t
             try:
                 h, te = self._attempt(t, h, before, state)
                 if te is not None:
@@ -374,13 +372,13 @@ class RegimeAwareMaster:
                         # approach it in shorter steps (the held-input error at an impact
                         # is the speed mismatch of the two sides, hence the energy).
                         h = max(cfg.min_step, h * control.shrink(ratio, self.first_order))
-                        self._rollback(state)
+                        self._rollback(state, before)
                         last_ratio = None
                         continue
                     return h, te  # the step ends on the switch
                 # End the retaken step just past the located instant.
                 h = max(te - t + 0.5 * cfg.event_tolerance, cfg.min_step)
-                self._rollback(state)
+                self._rollback(state, before)
                 last_ratio = None
                 continue
             ratio = self.step_ratio(before)
@@ -394,7 +392,7 @@ class RegimeAwareMaster:
                     return h, t + h  # land after the jump and treat it as a switch
                 last_ratio = ratio
                 h = max(cfg.min_step, h * control.shrink(ratio, self.first_order))
-                self._rollback(state)
+                self._rollback(state, before)
                 continue
             return h, None
         raise RunError(
@@ -416,7 +414,7 @@ class RegimeAwareMaster:
         crossed = [list(v) for v in self.system.values]  # the predictor across the switch
         h_left = te - t - 0.5 * cfg.event_tolerance
         if h_left > 0.0:
-            self._restore(state)
+            self._restore(state, before)
             self.trial(t, h_left)
             predicted = [list(v) for v in self.system.values]
             # Kept as the recorded values just before the switch: the accepted step's error
@@ -446,7 +444,7 @@ class RegimeAwareMaster:
         if self.cfg.midpoint and self.left_row is not None:
             return self.left_row  # taken on the way to this step (_correct_landing)
         accepted = self.predicted
-        self._rollback(state)
+        self._rollback(state, before)
         self.trial(t, h_left)
         if self.cfg.midpoint:
             predicted = [list(v) for v in self.system.values]
@@ -456,19 +454,20 @@ class RegimeAwareMaster:
             # The very inputs of the accepted step: the retake must cross the switch again.
             self.corrected_trial(t, h, before, state, accepted)
         else:
-            self._rollback(state)
+            self._rollback(state, before)
             self.trial(t, h)
         return row
 
-    def _restore(self, state: list[Any]) -> None:
-        """Back to the step start (a rollback, not a rejection: the corrector's retake)."""
-        self.system.set_state(state, self.start_values)
+    def _restore(self, state: list[Any], before: _Snapshot) -> None:
+        """Back to the step start (a rollback, not a rejection: the corrector's retake);
+        the values there are those read then."""
+        self.system.set_state(state, (before.values, before.ints))
         self.stats.rollbacks += 1
         self.predictor_end = None
 
-    def _rollback(self, state: list[Any]) -> None:
+    def _rollback(self, state: list[Any], before: _Snapshot) -> None:
         """Back to the step start after a rejected trial."""
-        self._restore(state)
+        self._restore(state, before)
         self.stats.rejections += 1
 
     def _last_switch(self) -> str:

@@ -77,12 +77,9 @@ def run_jobs(
     raises here)."""
     # Loading a scene builds (or finds cached) its FMUs: here, once per distinct set, so
     # that workers never build one at the same time.
-    distinct = {}
-    for job in jobs:
-        scene, overrides = _fmu_choice(job)
-        distinct.setdefault((scene, repr(overrides)), (scene, overrides))
-    for scene, overrides in distinct.values():
-        load_scene(scene, overrides)
+    distinct = {(job.scene, repr(_fmu_choice(job))): job for job in jobs}
+    for job in distinct.values():
+        load_scene(job.scene, _fmu_choice(job))
     results: list[JobResult | None] = [None] * len(jobs)
     for k, outcome in iter_jobs(jobs, workers, dask_address):
         if isinstance(outcome, Exception):
@@ -91,15 +88,14 @@ def run_jobs(
     return results  # type: ignore[return-value]  # every index was filled
 
 
-def _fmu_choice(job: Job) -> tuple[str, dict[str, Any]]:
-    """What decides the FMUs a job's scene needs: its file and the overrides that name an
-    FMU's component or file (parameters, inputs and master settings choose none)."""
-    chosen = {
+def _fmu_choice(job: Job) -> dict[str, Any]:
+    """The overrides of a job that name an FMU's component or file: with the scene file,
+    what decides the FMUs it needs (parameters, inputs and master settings choose none)."""
+    return {
         key: value
         for key, value in sorted(job.overrides.items())
         if key.split(".")[0] == "fmus" and key.split(".")[2:3] in ([], ["component"], ["fmu"])
     }
-    return job.scene, chosen
 
 
 def _ignore_sigint() -> None:

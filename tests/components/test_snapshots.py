@@ -5,22 +5,22 @@ from __future__ import annotations
 import pytest
 
 from components.base import Component, SnapshotPlan
-from components.brake_load import BrakeLoad
-from components.crank_coupler_drive import CrankCouplerDrive
-from components.detached_lever import DetachedLever
-from components.gear_mesh import GearMesh
-from components.rotational import Inertia, SpringDamperInertia
-from components.sprag_clutch import SpragClutch
+from fmus.registry import FMU_WRAPPERS
 
-SHARED = [
-    CrankCouplerDrive,
-    SpragClutch,
-    BrakeLoad,
-    DetachedLever,
-    Inertia,
-    SpringDamperInertia,
-    GearMesh,
-]
+#: Every FMU's component that snapshots by sharing everything (an empty plan).
+SHARED = sorted(
+    {
+        cls
+        for cls in (w.component_class() for w in FMU_WRAPPERS.values())
+        if cls.SNAPSHOT == SnapshotPlan()
+    },
+    key=lambda cls: cls.__name__,
+)
+
+
+def test_the_shared_ones_are_found() -> None:
+    names = {cls.__name__ for cls in SHARED}
+    assert names >= {"CrankCouplerDrive", "SpragClutch", "BrakeLoad", "DetachedLever", "Inertia"}
 
 
 def immutable(value: object) -> bool:
@@ -41,9 +41,8 @@ def stepped(cls: type[Component]) -> Component:
     return component
 
 
-@pytest.mark.parametrize("cls", SHARED)
+@pytest.mark.parametrize("cls", SHARED, ids=lambda cls: cls.__name__)
 def test_shared_snapshots_hold_only_immutable_values(cls: type[Component]) -> None:
-    assert cls.SNAPSHOT == SnapshotPlan()
     component = stepped(cls)
     mutable = {
         k: type(v).__name__
@@ -53,7 +52,7 @@ def test_shared_snapshots_hold_only_immutable_values(cls: type[Component]) -> No
     assert mutable == {}, f"{cls.__name__} would share these between snapshots: {mutable}"
 
 
-@pytest.mark.parametrize("cls", SHARED)
+@pytest.mark.parametrize("cls", SHARED, ids=lambda cls: cls.__name__)
 def test_a_restored_snapshot_retakes_the_same_steps(cls: type[Component]) -> None:
     component = stepped(cls)
     state = component.get_state()

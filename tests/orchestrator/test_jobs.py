@@ -49,7 +49,7 @@ def test_forked_and_spawned_workers_give_the_same_numbers(
 
 def test_only_overrides_that_choose_an_fmu_are_loaded_beforehand() -> None:
     def choice(overrides: dict) -> dict:
-        return job_runner._fmu_choice(Job("s.toml", overrides, "out"))[1]
+        return job_runner._fmu_choice(Job("s.toml", overrides, "out"))
 
     assert choice({"fmus.b.parameters.k": 2.0, "master.step": 1e-4}) == {}
     swapped = {"fmus.b.component": "Inertia", "fmus.c.fmu": "c.fmu", "fmus.d": {"fmu": "d.fmu"}}
