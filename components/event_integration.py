@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import NamedTuple, Protocol
 
 from .base import ComponentError, Variable
@@ -79,6 +79,13 @@ INTEGRATION_VARIABLES = (
         min=1.0e-9,
     ),
 )
+
+
+def integration_variables(h_max: float) -> tuple[Variable, Variable]:
+    """INTEGRATION_VARIABLES with another default largest step (a model whose indicators
+    change slowly need not cap its steps at 0.1 ms)."""
+    tolerance, largest = INTEGRATION_VARIABLES
+    return tolerance, replace(largest, start=h_max)
 
 
 def step_control(component: object, scales: tuple[float, ...]) -> StepControl:
