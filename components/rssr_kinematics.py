@@ -34,8 +34,19 @@ class ExactRSSR:
         self.c0 = lk.a4**2 + lk.s1**2 + lk.s2**2 + lk.s3**2 + lk.a1**2 - lk.a3**2
         self.f2_gain = 4.0 * lk.a3 * math.sin(alpha)  # F2 = 2 sin(alpha) * (-2 a3 / D)
         self.f2_const = f2_const
+        # The last angle asked and its answer: a step asks the same angle several times
+        # (outputs, indicators, the first stage), and the answer depends on nothing else.
+        self._memo: tuple[float, Kinematics] = (math.nan, (math.nan,) * 6)
 
     def __call__(self, phi1: float) -> Kinematics:
+        memo = self._memo
+        if memo[0] == phi1:
+            return memo[1]
+        out = self._solve(phi1)
+        self._memo = (phi1, out)
+        return out
+
+    def _solve(self, phi1: float) -> Kinematics:
         a1, a4, s2, s3, A = self.a1, self.a4, self.s2, self.s3, self.A
         sp, cp = math.sin(phi1), math.cos(phi1)
         B = 2.0 * a4 * (s3 + a1 * sp)
