@@ -420,6 +420,22 @@ def test_drive_elastic_energy_balance_under_a_held_torque():
     assert abs(d.q) > 1e-5  # the coupler is loaded
 
 
+def test_drive_accuracy_follows_its_tolerance_parameter():
+    def coupler_after(tolerance: float) -> float:
+        d = CrankCouplerDrive(tolerance=tolerance, h_max=1.0)
+        d.torque = T_B1
+        d.initialize(0.0)
+        h = 2e-3  # communication steps as long as a fast master's
+        for i in range(50):
+            d.step(i * h, h)
+        return d.q
+
+    truth = coupler_after(1e-13)
+    errors = [abs(coupler_after(tol) - truth) for tol in (1e-5, 1e-8, 1e-11)]
+    assert errors[0] > 30.0 * errors[1] > 0.0 and errors[1] > 30.0 * errors[2]
+    assert errors[1] < 1e-7 * abs(truth)
+
+
 def test_components_restore_state_bit_identically():
     comps = [CrankCouplerDrive(), SpragClutch(), BrakeLoad()]
     for c in comps:
