@@ -55,6 +55,7 @@ class RunResult:
     time_reached: float | None = None  # simulated time the run got to
     notes: list[str] = field(default_factory=list)  # what could not be computed, and why
     interrupted_by: int | None = None  # the signal that interrupted the run
+    reference: Reference | None = None  # the reference the run was compared with, if any
 
     def signal(self, name: str) -> np.ndarray:
         """Recorded column by name ('time' or '<instance>.<variable>')."""
@@ -149,10 +150,11 @@ def _run_locked(
     data = recorder.array()
     quantities: dict[str, dict[str, Any]] = {}
     accuracy: dict[str, float] = {}
+    ref: Reference | None = None
     try:
         # No FMU is alive any more: a signal may now stop the analyses where it lands.
         with guard.raise_at_once(), _without_numeric_warnings():
-            quantities, accuracy = _analyse(
+            quantities, accuracy, ref = _analyse(
                 scene, out, recorder, data, status, compare_reference, plots, notes
             )
     except Interrupted as exc:
@@ -192,6 +194,7 @@ def _run_locked(
         reached[0],
         notes,
         guard.signum if status == "interrupted" else None,
+        ref,
     )
 
 
@@ -204,9 +207,10 @@ def _analyse(
     compare_reference: bool,
     plots: bool,
     notes: list[str],
-) -> tuple[dict[str, dict[str, Any]], dict[str, float]]:
-    """Headline, energy residual, scene analysis, plot and error against the reference:
-    each that fails adds a note saying why, and the others still count."""
+) -> tuple[dict[str, dict[str, Any]], dict[str, float], Reference | None]:
+    """Headline, energy residual, scene analysis, plot and error against the reference
+    (returned with them): each that fails adds a note saying why, and the others still
+    count."""
     header = recorder.header
     quantities: dict[str, dict[str, Any]] = {}
     with _noted(notes, "headline quantities", header):
@@ -222,12 +226,13 @@ def _analyse(
             with _noted(notes, f"plot of {scene.analysis!r}", header):
                 PLOTS[scene.analysis](scene, header, data, out / f"{scene.name}.png")
     accuracy: dict[str, float] = {}
+    ref = None
     if scene.reference and status == "completed" and compare_reference:
         with _noted(notes, f"reference {scene.reference!r}", header):
             ref = reference_of(scene)
             accuracy = compare(header, data, recorder.events, quantities, ref, notes)
             accuracy["reference_wall_time"] = ref.wall_time
-    return quantities, accuracy
+    return quantities, accuracy, ref
 
 
 @contextmanager

@@ -22,7 +22,7 @@ from pathlib import Path
 
 import pytest
 
-from orchestrator.run import RunResult, reference_of, run_scene
+from orchestrator.run import RunResult, run_scene
 from orchestrator.scenario import load_scene
 from orchestrator.scenes.press_feed.report import (
     FEED,
@@ -47,7 +47,7 @@ def runs(fmu_cache, tmp_path_factory):
             scene = load_scene(SCENARIOS / name, REGIME_AWARE)
             out = tmp_path_factory.mktemp(scene.name)
             result = run_scene(scene, out, cache_dir=fmu_cache, show_progress=False, plots=False)
-            done[name] = (result, reference_of(scene))
+            done[name] = (result, result.reference)
         return done[name]
 
     return get

@@ -87,13 +87,13 @@ def runs(fmu_cache, tmp_path_factory):
 
 
 @pytest.fixture(scope="module")
-def references():
-    done: dict[str, object] = {}
+def references(runs):
+    """Each scene's monolithic reference: the one its run was compared with."""
 
     def get(name: str):
-        if name not in done:
-            done[name] = reference_of(load_scene(SCENARIOS / name))
-        return done[name]
+        ref = runs(name).reference
+        assert ref is not None, runs(name).notes
+        return ref
 
     return get
 
