@@ -297,15 +297,10 @@ class RegimeAwareMaster:
         control = self.control
         t, stop = self.start, self.stop
         h = cfg.first_step
-        target: float | None = None  # a switch seen in a rolled-back trial, not yet reached
         recorder.row(system.record_row(t))
         same_instant = 0
         while t < stop - control.stop_slack * max(1.0, abs(stop)):
-            if target is not None and target <= t:
-                target = None
             h = min(h, stop - t)
-            if target is not None:
-                h = min(h, target - t + 0.5 * cfg.event_tolerance)
             state = system.get_state()
             before = self.snapshot()  # consistent: every trial and settle ends refreshed
             try:
@@ -324,7 +319,6 @@ class RegimeAwareMaster:
                 h = min(cfg.max_step, h * control.grow(ratio, self.first_order))
                 same_instant = 0
             else:
-                target = None
                 if left is not None:
                     recorder.row(left)  # values just before the switch
                 stats.iterations += self.settle() - 1
