@@ -47,6 +47,7 @@ def runs(fmu_cache, tmp_path_factory):
             scene = load_scene(SCENARIOS / name, REGIME_AWARE)
             out = tmp_path_factory.mktemp(scene.name)
             result = run_scene(scene, out, cache_dir=fmu_cache, show_progress=False, plots=False)
+            assert result.reference is not None, result.notes
             done[name] = (result, result.reference)
         return done[name]
 
