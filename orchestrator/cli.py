@@ -5,11 +5,13 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import signal
 import sys
 import tomllib
 from pathlib import Path
 
 from orchestrator.errors import RunError, ScenarioError
+from orchestrator.interrupt import Interrupted, report_interrupted
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -150,15 +152,14 @@ def main(argv: list[str] | None = None) -> int:
     p.set_defaults(handler=_report)
 
     args = parser.parse_args(argv)
-    try:
-        from fmus.build import BuildError
+    from fmus.build import BuildError  # before the try: its except clauses name it
 
+    try:
         return args.handler(args)
-    except KeyboardInterrupt:
+    except (KeyboardInterrupt, Interrupted) as exc:
         if args.debug:
             raise
-        print("interrupted", file=sys.stderr)
-        return 130
+        return report_interrupted(exc.signum if isinstance(exc, Interrupted) else signal.SIGINT)
     except (ScenarioError, RunError, BuildError, OSError, UnicodeError) as exc:
         # bad input: a scene, a path, a cache, a results directory
         if args.debug:
@@ -335,8 +336,8 @@ def _crosscheck(args: argparse.Namespace) -> int:
             f"{o.agreement.points} points, {len(o.agreement.per_signal)} signals, "
             f"{o.run.wall_time:.2f} s: {'ok' if o.ok else 'NOT MET'}"
         )
-        for signal, why in o.run.not_compared.items():
-            print(f"    not compared: {signal} ({why})")
+        for quantity, why in o.run.not_compared.items():
+            print(f"    not compared: {quantity} ({why})")
     print("  agreement: max over signals of max_k |ours - theirs| / max_k max(|ours|, |theirs|)")
     return 0 if check.ok else 1
 
@@ -451,4 +452,6 @@ def _report(args: argparse.Namespace) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    from orchestrator.entry import main as entry
+
+    sys.exit(entry())

@@ -44,6 +44,12 @@ def signal_name(signum: int) -> str:
         return f"signal {signum}"
 
 
+def report_interrupted(signum: int) -> int:
+    """Say on standard error that the command was interrupted; its exit code."""
+    print(f"interrupted by {signal_name(signum)}", file=sys.stderr)
+    return 128 + signum
+
+
 class SignalGuard:
     """Turns SIGINT/SIGTERM into a flag (or, in raising mode, into ``Interrupted``)."""
 

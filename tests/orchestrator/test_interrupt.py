@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from orchestrator import entry
 from orchestrator.interrupt import Interrupted, SignalGuard, catching_signals
 from orchestrator.output_lock import LOCK_NAME
 
@@ -37,9 +38,9 @@ def _catches_sigterm(pid: int) -> bool | None:
 
 
 def _wait_for_handlers(proc: subprocess.Popen, timeout: float = 60.0) -> None:
-    """Wait until the run command has taken over SIGINT and SIGTERM.  Before that the
-    interpreter is still starting (about 0.1 s on an idle machine, several times that on
-    a loaded one) and no Python program can answer a signal yet."""
+    """Wait until the command has taken over SIGINT and SIGTERM (its first line does).
+    Before that the interpreter is still starting (about 0.05 s on an idle machine,
+    several times that on a loaded one) and no Python program can answer a signal yet."""
     end = time.perf_counter() + timeout
     while time.perf_counter() < end and proc.poll() is None:
         caught = _catches_sigterm(proc.pid)
@@ -53,7 +54,7 @@ def interrupt_run(out: Path, delay: float, sig: int) -> tuple[int, str, float]:
     it has taken over the signals; (exit code, stderr, seconds from the signal to the
     exit)."""
     proc = subprocess.Popen(
-        [sys.executable, "-m", "orchestrator.cli", "run", str(M739), "--no-progress"]
+        [sys.executable, "-m", "orchestrator", "run", str(M739), "--no-progress"]
         + ["--output", str(out)],
         cwd=PROJECT_DIR,
         stdout=subprocess.PIPE,
@@ -73,10 +74,19 @@ def interrupt_run(out: Path, delay: float, sig: int) -> tuple[int, str, float]:
     return proc.returncode, err, time.perf_counter() - sent
 
 
-def assert_interrupted(out: Path, code: int, err: str, sig: int, delay: float) -> float:
+def assert_interrupted(
+    out: Path, code: int, err: str, sig: int, delay: float, started: bool = True
+) -> float | None:
+    """Check an interrupted run; its simulated time reached.  With ``started`` false the
+    signal may also have come before the run began (its modules still loading): then the
+    command ends with one line and leaves no results (None)."""
     what = f"{signal.Signals(sig).name} after {delay:.2f} s"
     assert code == 128 + sig, f"{what}: exit {code}; stderr: {err[-2000:]}"
     assert "Traceback" not in err, f"{what}: {err[-2000:]}"
+    if not started and not (out / "summary.json").exists():
+        assert err.strip().splitlines()[-1] == f"interrupted by {signal.Signals(sig).name}", err
+        assert not out.exists() or not any(out.iterdir()), what
+        return None
     summary = json.loads((out / "summary.json").read_text())
     assert summary["status"] == "interrupted", what
     assert signal.Signals(sig).name in summary["message"], summary["message"]
@@ -105,6 +115,24 @@ def test_guard_turns_a_signal_into_a_flag_checked_between_steps() -> None:
     assert signal.getsignal(signal.SIGTERM) is signal.SIG_DFL  # restored
 
 
+def test_command_sigterm_raises_in_the_command_and_ends_a_forked_worker_quietly() -> None:
+    previous = signal.signal(signal.SIGTERM, entry._raise_interrupted)
+    try:
+        with pytest.raises(Interrupted) as info:
+            os.kill(os.getpid(), signal.SIGTERM)
+        assert info.value.exit_code == 143
+        pid = os.fork()
+        if pid == 0:  # a pool worker forked from the command
+            try:
+                os.kill(os.getpid(), signal.SIGTERM)
+            finally:
+                os._exit(3)  # reached only if SIGTERM did not end the worker
+        _, status = os.waitpid(pid, 0)
+        assert os.WIFSIGNALED(status) and os.WTERMSIG(status) == signal.SIGTERM, status
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
 def test_guard_raises_at_once_only_when_asked() -> None:
     guard = SignalGuard()
     guard.handle(signal.SIGINT, None)  # flag only
@@ -117,8 +145,19 @@ def test_guard_raises_at_once_only_when_asked() -> None:
 def test_run_interrupted_at_a_random_moment(tmp_path: Path, sig: int) -> None:
     delay = random.uniform(0.0, 4.0)
     code, err, latency = interrupt_run(tmp_path / "out", delay, sig)
-    assert_interrupted(tmp_path / "out", code, err, sig, delay)
+    assert_interrupted(tmp_path / "out", code, err, sig, delay, started=False)
     assert latency < 30.0
+
+
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
+def test_run_interrupted_while_its_modules_load(tmp_path: Path, sig: int) -> None:
+    """A signal in the first 0.15 s, while the command imports its modules: one line and
+    exit 130 / 143, never a traceback, never swallowed (the run going on to the end)."""
+    for k, delay in enumerate((0.0, 0.02, 0.05, 0.1, 0.15)):
+        out = tmp_path / f"run{k}"
+        code, err, latency = interrupt_run(out, delay, sig)
+        assert_interrupted(out, code, err, sig, delay, started=False)
+        assert latency < 30.0
 
 
 @pytest.mark.slow
@@ -133,5 +172,6 @@ def test_run_interrupted_twenty_times(tmp_path: Path) -> None:
         delay = rng.uniform(0.0, 18.0)
         out = tmp_path / f"run{k}"
         code, err, _ = interrupt_run(out, delay, sig)
-        reached.append(assert_interrupted(out, code, err, sig, delay) if code else None)
+        done = code == 0  # the run ended before the signal came
+        reached.append(None if done else assert_interrupted(out, code, err, sig, delay, False))
     print(f"seed {seed}: simulated times reached {reached}")
