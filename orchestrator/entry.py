@@ -15,7 +15,7 @@ import os
 import signal
 import sys
 
-from orchestrator.interrupt import Interrupted, catching_signals, report_interrupted
+from orchestrator.interrupt import SIGNALS, Interrupted, catching_signals, report_interrupted
 
 _COMMAND_PID = os.getpid()
 
@@ -37,7 +37,8 @@ def main(argv: list[str] | None = None) -> int:
     the import machinery can be swallowed (the command then runs on as if nothing had come)
     or leave a module half-imported.  The flag is read once they have loaded.  From there
     on SIGTERM raises ``Interrupted`` as SIGINT raises KeyboardInterrupt, until a run
-    installs its own guard."""
+    installs its own guard.  Once the command has returned both are ignored: this is the
+    process's last work."""
     with catching_signals() as guard:
         import fmus.build  # noqa: F401 - the command's other import before a run's guard
         from orchestrator.cli import main as command
@@ -46,11 +47,17 @@ def main(argv: list[str] | None = None) -> int:
     if signal.getsignal(signal.SIGTERM) is signal.SIG_DFL:
         signal.signal(signal.SIGTERM, _raise_interrupted)
     try:
-        return command(argv)
+        code = command(argv)
     except (KeyboardInterrupt, Interrupted) as exc:
         if "--debug" in (sys.argv[1:] if argv is None else argv):
             raise
-        return report_interrupted(exc.signum if isinstance(exc, Interrupted) else signal.SIGINT)
+        code = report_interrupted(exc.signum if isinstance(exc, Interrupted) else signal.SIGINT)
+    # The work is done and the exit code decided.  The interpreter's shutdown puts the
+    # signals back to their defaults, so a signal now would kill the process (exit -15 for
+    # a run that completed); ignored, it changes nothing.
+    for sig in SIGNALS:
+        signal.signal(sig, signal.SIG_IGN)
+    return code
 
 
 if __name__ == "__main__":
