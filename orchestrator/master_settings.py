@@ -73,6 +73,12 @@ class StepControl:
     event_time_slack: float = 1e-12  # relative: a reported event time this past the end counts
     stop_slack: float = 1e-15  # relative: a run this close to its stop time has reached it
     settle_window: float = 10.0  # switches within this many event tolerances: one instant
+    # After a switch into regimes where every accepted step so far had zero coupling error
+    # (nothing the held inputs reach is exchanged, e.g. a verge in free flight), restart at
+    # this fraction of the step proposed there last, not at master.step: the ramp from
+    # master.step bought nothing there.  Not the whole step: the next switch is usually
+    # nearer (at 1, M739 took 9 % more doSteps than at 1/4).
+    zero_error_restart: float = 0.25
 
     def factor(self, ratio: float, first_order: bool) -> float:
         """Step factor for an error ratio: the held-start estimate is first order in h,
@@ -96,7 +102,7 @@ class StepControl:
 class RegimeAwareSettings:
     """Error-controlled steps that land on every regime switch (masters/regime_aware.py)."""
 
-    first_step: float  # master.step: the first step and the step after a switch [s]
+    first_step: float  # master.step: the first step, and the step after a switch [s]
     tolerance: float = setting(1e-4, "1")  # coupling error per step, relative to scale
     event_tolerance: float = setting(1e-10, "s")  # how closely a step lands on a switch
     min_step: float = setting(1e-14, "s")

@@ -116,6 +116,9 @@ class RegimeAwareMaster:
         self.located = False  # the last switch_time is an instant an FMU reported
         #: switches this close are one instant (chattering guard, landing on a located switch)
         self.instant = settings.control.settle_window * settings.event_tolerance
+        #: per combination of regimes in which every accepted step had zero coupling error:
+        #: the largest step the controller proposed there (the restart after a switch)
+        self.zero_error_step: dict[tuple[int | None, ...], float] = {}
 
     # -- helpers ----------------------------------------------------------------------
     def snapshot(self) -> _Snapshot:
@@ -317,6 +320,7 @@ class RegimeAwareMaster:
                 stats.events += self.log_switches(t - h, before)  # switched at the start
                 recorder.row(system.record_row(t))
                 h = min(cfg.max_step, h * control.grow(ratio, self.first_order))
+                self._remember_step(tuple(before.regimes), ratio, h)
                 same_instant = 0
             else:
                 if left is not None:
@@ -333,12 +337,26 @@ class RegimeAwareMaster:
                         f"last in {self._last_switch()}",
                         t,
                     )
-                h = cfg.first_step
+                h = self._restart_step(tuple(system.regimes()))
             progress(t)
             stop_indicator = system.stop_indicator()
             if stop_indicator is not None and stop_indicator <= 0.0:
                 stats.extra["stopped_by_condition"] = True
                 return
+
+    def _remember_step(self, regimes: tuple[int | None, ...], ratio: float, h: float) -> None:
+        """Keep the step proposed after an accepted one in ``regimes`` while no step there
+        has had a coupling error."""
+        if ratio == 0.0:
+            self.zero_error_step[regimes] = max(h, self.zero_error_step.get(regimes, 0.0))
+        else:
+            self.zero_error_step.pop(regimes, None)
+
+    def _restart_step(self, regimes: tuple[int | None, ...]) -> float:
+        """The first step after a switch into ``regimes``: master.step, or where the
+        coupling error has been exactly zero, a fraction of the step proposed there."""
+        remembered = self.zero_error_step.get(regimes, 0.0) * self.control.zero_error_restart
+        return max(self.cfg.first_step, min(self.cfg.max_step, remembered))
 
     def _attempt(self, t: float, h: float, before: _Snapshot, state: list[Any]):
         """Trial steps from t until one is accepted; returns (h, switch time or None).

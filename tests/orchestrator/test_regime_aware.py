@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from orchestrator.run import run_scene
@@ -86,3 +88,53 @@ def test_bad_stop_condition_is_refused(tmp_path) -> None:
         load_scene(SCENE, {"scene.stop_when": {"signal": "a.phi"}})
     with pytest.raises(ScenarioError, match=r"stop_when.above.*cannot be converted to rad"):
         load_scene(SCENE, {"scene.stop_when": {"signal": "a.phi", "above": "1 s"}})
+
+
+M739 = Path(__file__).resolve().parents[2] / "scenarios" / "m739.toml"
+
+
+def _m739_first_4_ms(tmp_path, fmu_cache, zero_error_restart: float):
+    scene = load_scene(M739, {"scene.stop": "4 ms", "master.tolerance": 1e-2})
+    settings = scene.master.settings
+    control = replace(settings.control, zero_error_restart=zero_error_restart)
+    master = replace(scene.master, settings=replace(settings, control=control))
+    return run_scene(
+        replace(scene, master=master),
+        output_dir=tmp_path / f"restart{zero_error_restart}",
+        cache_dir=fmu_cache,
+        show_progress=False,
+        plots=False,
+        compare_reference=False,
+    )
+
+
+def _first_steps_into(result, regime: str) -> list[float]:
+    """The first step after each switch of the verge into ``regime``."""
+    t = result.data[:, 0]
+    return [
+        float(t[t > te + 1e-12][0] - te)
+        for te, sub, _, to in result.events
+        if sub == "verge" and to == regime and np.any(t > te + 1e-12)
+    ]
+
+
+def test_free_flight_restarts_at_a_quarter_of_the_step_it_reached(tmp_path, fmu_cache) -> None:
+    """In free flight the coupling error is exactly zero: after the first one, a switch into
+    it restarts at a quarter of the step proposed there (max_step 100 µs, so 25 µs), not at
+    master.step; the coupled phases, whose error is not zero, still restart at 1 µs.  The
+    motion and its switches are the same."""
+    ramp = _m739_first_4_ms(tmp_path, fmu_cache, 0.0)
+    remembered = _m739_first_4_ms(tmp_path, fmu_cache, 0.25)
+    assert _first_steps_into(ramp, "free") == pytest.approx([1e-6] * 12, rel=1e-6)
+    free = _first_steps_into(remembered, "free")
+    assert len(free) == 12 and free[0] == pytest.approx(1e-6, rel=1e-6)
+    assert min(free[1:]) > 20e-6 and max(free[1:]) == pytest.approx(25e-6, rel=1e-6), free
+    for coupled in ("coupled-entrance", "coupled-exit"):
+        steps = _first_steps_into(remembered, coupled)
+        assert steps and steps == pytest.approx([1e-6] * len(steps), rel=1e-6), steps
+    assert [e[1:] for e in remembered.events] == [e[1:] for e in ramp.events]
+    switch_times = np.array([e[0] for e in remembered.events])
+    assert np.max(np.abs(switch_times - [e[0] for e in ramp.events])) < 1e-9
+    phi = remembered.header.index("train.phi")
+    assert remembered.data[-1, phi] == pytest.approx(ramp.data[-1, phi], rel=1e-6)
+    assert remembered.stats.do_steps < 0.95 * ramp.stats.do_steps
