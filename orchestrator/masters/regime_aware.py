@@ -25,8 +25,10 @@ be rolled back.  A trial step is accepted when
 
 After a switch the master iterates the exchange at that instant to a fixed point (so an
 impact's momentum exchange reaches the other FMU before anything moves), records the left
-and right values, logs the switch, and restarts with a short step.  A guard stops runs
-that keep switching at one instant (chattering / Zeno) with a diagnosis.
+and right values, logs the switch, and restarts with a short step (``master.step``; into
+regimes where every accepted step so far had zero coupling error, a fraction of the step
+proposed there last).  A guard stops runs that keep switching at one instant (chattering /
+Zeno) with a diagnosis.
 """
 
 from __future__ import annotations
