@@ -5,13 +5,12 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import signal
 import sys
 import tomllib
 from pathlib import Path
 
 from orchestrator.errors import RunError, ScenarioError
-from orchestrator.interrupt import Interrupted, report_interrupted
+from orchestrator.interrupt import Interrupted, report_interrupted, signum_of
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -159,7 +158,7 @@ def main(argv: list[str] | None = None) -> int:
     except (KeyboardInterrupt, Interrupted) as exc:
         if args.debug:
             raise
-        return report_interrupted(exc.signum if isinstance(exc, Interrupted) else signal.SIGINT)
+        return report_interrupted(signum_of(exc))
     except (ScenarioError, RunError, BuildError, OSError, UnicodeError) as exc:
         # bad input: a scene, a path, a cache, a results directory
         if args.debug:

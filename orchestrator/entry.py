@@ -15,7 +15,13 @@ import os
 import signal
 import sys
 
-from orchestrator.interrupt import SIGNALS, Interrupted, catching_signals, report_interrupted
+from orchestrator.interrupt import (
+    SIGNALS,
+    Interrupted,
+    catching_signals,
+    report_interrupted,
+    signum_of,
+)
 
 _COMMAND_PID = os.getpid()
 
@@ -51,7 +57,7 @@ def main(argv: list[str] | None = None) -> int:
     except (KeyboardInterrupt, Interrupted) as exc:
         if "--debug" in (sys.argv[1:] if argv is None else argv):
             raise
-        code = report_interrupted(exc.signum if isinstance(exc, Interrupted) else signal.SIGINT)
+        code = report_interrupted(signum_of(exc))
     # The work is done and the exit code decided.  The interpreter's shutdown puts the
     # signals back to their defaults, so a signal now would kill the process (exit -15 for
     # a run that completed); ignored, it changes nothing.

@@ -44,6 +44,11 @@ def signal_name(signum: int) -> str:
         return f"signal {signum}"
 
 
+def signum_of(exc: KeyboardInterrupt | Interrupted) -> int:
+    """The signal behind an interruption: KeyboardInterrupt is Python's SIGINT."""
+    return exc.signum if isinstance(exc, Interrupted) else signal.SIGINT
+
+
 def report_interrupted(signum: int) -> int:
     """Say on standard error that the command was interrupted; its exit code."""
     print(f"interrupted by {signal_name(signum)}", file=sys.stderr)

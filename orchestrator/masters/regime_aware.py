@@ -358,7 +358,7 @@ class RegimeAwareMaster:
         """The first step after a switch into ``regimes``: master.step, or where the
         coupling error has been exactly zero, a fraction of the step proposed there."""
         remembered = self.zero_error_step.get(regimes, 0.0) * self.control.zero_error_restart
-        return max(self.cfg.first_step, min(self.cfg.max_step, remembered))
+        return max(self.cfg.first_step, remembered)  # remembered steps are <= max_step
 
     def _attempt(self, t: float, h: float, before: _Snapshot, state: list[Any]):
         """Trial steps from t until one is accepted; returns (h, switch time or None).
