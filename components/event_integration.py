@@ -300,6 +300,37 @@ def _first_step(y: list[float], k1: list[float], control: StepControl) -> float:
     return 0.01 * d0 / d1
 
 
+def _fire_at_instant(
+    model: EventModel, y: list[float], first: int, t: float, g_start: Sequence[float]
+) -> tuple[list[float], int]:
+    """Handle event ``first`` at t, then every other event of the same instant.
+
+    An indicator that was armed (>= 0) at the step start and is past zero once an event
+    has been handled crossed at this instant too, within the location tolerance, or was
+    pushed across by that event's change of state.  Either way it fires here: after the
+    first, in index order, each once, every one seeing the state the previous one left.
+    Without this it would start the next step below zero and never fire (two crossings
+    at one instant would lose one).  Returns the state and the number of events fired.
+    """
+    y = model.event(y, first, t)
+    fired = {first}
+    while not getattr(model, "halted", False):
+        g = model.indicators(y)
+        nxt = next(
+            (
+                j
+                for j, (a, b) in enumerate(zip(g_start, g, strict=True))
+                if b < 0.0 <= a and j not in fired
+            ),
+            -1,
+        )
+        if nxt < 0:
+            break
+        y = model.event(y, nxt, t)
+        fired.add(nxt)
+    return y, len(fired)
+
+
 def advance(
     model: EventModel,
     y: list[float],
@@ -315,8 +346,10 @@ def advance(
 
     An indicator fires when it goes from >= 0 to < 0 (at once if it is exactly 0 at the
     step start); the located point is just past the crossing, so an event handler that
-    leaves y there sees the new side and does not fire again.  The model's ``event``
-    changes its mode (and may change y); the integration then continues from there.
+    leaves y there sees the new side and does not fire again.  The earliest crossing in
+    a step fires first; others of the same instant follow it (``_fire_at_instant``).  The
+    model's ``event`` changes its mode (and may change y); the integration then continues
+    from there.
     ``h_try`` is the step to try first (the ``h_next`` of the previous call; 0: choose).
     ``observe(t0, t1, state_at)`` is called for every stretch integrated in one mode,
     before the mode changes: ``state_at(t)`` is the state at any t in [t0, t1] (offsets
@@ -392,13 +425,13 @@ def advance(
         t += th_best
         if th_best > 0.0 and accept is not None:
             accept(y, t)
-        y = model.event(y, first, t)
+        y, fired = _fire_at_instant(model, y, first, t, g0)
         k1 = deriv(y)
         g0 = model.indicators(y)
         t_event = t
         if t_first < 0.0:
             t_first = t
-        n_events += 1
+        n_events += fired
         if n_events > max_events:
             raise ComponentError("too many events inside one step (chattering)")
         h = h_next

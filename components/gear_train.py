@@ -26,10 +26,18 @@ approach/recess signs s1, s2 of both meshes and the current tooth pair, and by t
 branch of I1R (sign of phi_d times the acceleration, a located event).  The outputs
 J_ref, T_ref are those of the piece in force at the current state.
 
-Mesh position (subroutine ALFA and the main program):
-alpha_i = alpha_in + mod(k_i phi + J_i range, range)
-with k2 = r_b3/R_b2 (physical, default) or 32 r_b3/R_b2 (the report's as-run rate),
-k1 = k2 r_b2/R_b1.  Tooth changes and pitch-point crossings are located as events.
+Mesh position (subroutine ALFA for the contact range, the main program for the rest):
+alpha_i = alpha_in + mod(k_i phi + J_i range_i, span_i), range_i = alpha_fin - alpha_in.
+Physical indexing (default): the driver rolls with its own rotation, k1 = |N31| = 1/32
+and k2 = |N32| = 8/36 (the tooth ratios; the rounded base radii give r_b3/R_b2 = 0.22223,
+the same ratio to 4 digits), and the next tooth pair takes over once per tooth pitch of
+the driven pinion, so span_i = 2 pi/N_Gi is one base pitch of the driver (Tepper 1981,
+ARLCD-TR-81020, eq. 24: "one base pitch.  After this, the computations begin
+repeating").  Mesh 2 hands over every 45 deg of phi and mesh 1 every 180 deg.  As-run
+indexing reproduces SANDA2V's listing (IN2: IF (ALPHA2.GT.AL2FIN) ALPHA2=AL2IN): k2 = 32
+r_b3/R_b2, k1 = k2 r_b2/R_b1 and span_i = range_i, a hand-over every contact range, which
+with contact ratios of 0.9990 and 0.9993 runs ahead of the teeth.  Tooth changes and
+pitch-point crossings are located as events.
 
 """
 
@@ -108,16 +116,32 @@ class TrainPhysics:
         self.al2_in, self.al2_fin = mesh_limits(d.rb2_cap, d.rb3, d.theta2, d.ro2_cap, d.ro3)
         self.range1 = self.al1_fin - self.al1_in
         self.range2 = self.al2_fin - self.al2_in
-        k2 = d.rb3 / d.rb2_cap
-        if int(indexing) == INDEXING_AS_RUN:
-            k2 *= 32.0
-        self.k2 = k2
-        self.k1 = k2 * d.rb2 / d.rb1_cap
-        # Mesh phases in units of one contact interval: u = k phi / range + J.
-        self.du1 = self.k1 / self.range1
-        self.du2 = self.k2 / self.range2
-        self.p1 = (self.tan1 - self.al1_in) / self.range1  # pitch point, fraction of range
-        self.p2 = (self.tan2 - self.al2_in) / self.range2
+        self.indexing = int(indexing)
+        if self.indexing == INDEXING_AS_RUN:
+            # SANDA2V's listing (IN2): alpha_2 advances at 32 r_b3/R_b2 per radian of phi
+            # and is reset to alpha_in when it passes alpha_fin, so a cycle spans the
+            # roll-angle range of contact.
+            self.k2 = 32.0 * d.rb3 / d.rb2_cap
+            self.k1 = self.k2 * d.rb2 / d.rb1_cap
+            self.span1, self.span2 = self.range1, self.range2
+        else:
+            # Each driver rolls with its own rotation (tooth ratios, B122 and B159) and the
+            # next tooth pair takes over once per tooth pitch of the driven pinion: every
+            # 2 pi/N_P3 of phi in mesh 2 and 2 pi/(N_P2 |N32|) in mesh 1.  A cycle then
+            # spans one base pitch of the driver, 2 pi/N_G, as Tepper (1981, eq. 24)
+            # states it; the contact ranges of the rounded data fall short of that by
+            # their contact ratios, 0.9993 and 0.9990 (the design intends unity).
+            self.k1 = abs(d.n31)
+            self.k2 = abs(d.n32)
+            self.span1 = 2.0 * math.pi / d.ng1
+            self.span2 = 2.0 * math.pi / d.ng2
+        # Mesh phases in units of one cycle: u = k phi / span + J range / span.
+        self.du1 = self.k1 / self.span1
+        self.du2 = self.k2 / self.span2
+        self.u1_start = d.j1 * self.range1 / self.span1
+        self.u2_start = d.j2 * self.range2 / self.span2
+        self.p1 = (self.tan1 - self.al1_in) / self.span1  # pitch point, fraction of a cycle
+        self.p2 = (self.tan2 - self.al2_in) / self.span2
         self.i_stot = d.i_stot
         self._cache: dict[tuple[int, int, int], tuple[float, ...]] = {}
         # Mode.
@@ -144,14 +168,13 @@ class TrainPhysics:
 
     def set_mode(self, phi: float, direction: int) -> None:
         """Set the mesh pieces from the position phi and the direction of motion."""
-        d = self.d
         self.direction = 1 if direction >= 0 else -1
-        u1 = self.du1 * phi + d.j1
-        u2 = self.du2 * phi + d.j2
+        u1 = self.du1 * phi + self.u1_start
+        u2 = self.du2 * phi + self.u2_start
         self.n1, self.s1, lo1, hi1 = self._piece(u1, self.p1, self.direction)
         self.n2, self.s2, lo2, hi2 = self._piece(u2, self.p2, self.direction)
-        self.phi_lo = max((lo1 - d.j1) / self.du1, (lo2 - d.j2) / self.du2)
-        self.phi_hi = min((hi1 - d.j1) / self.du1, (hi2 - d.j2) / self.du2)
+        self.phi_lo = max((lo1 - self.u1_start) / self.du1, (lo2 - self.u2_start) / self.du2)
+        self.phi_hi = min((hi1 - self.u1_start) / self.du1, (hi2 - self.u2_start) / self.du2)
         self._k = self._constants(self.direction, self.s1, self.s2)
 
     def _constants(self, direction: int, s1: int, s2: int) -> tuple[float, ...]:
@@ -208,9 +231,8 @@ class TrainPhysics:
 
     def mesh_alphas(self, phi: float) -> tuple[float, float]:
         """Driver roll angles of both meshes on the current tooth pairs."""
-        d = self.d
-        al1 = self.al1_in + self.range1 * (self.du1 * phi + d.j1 - self.n1)
-        al2 = self.al2_in + self.range2 * (self.du2 * phi + d.j2 - self.n2)
+        al1 = self.al1_in + self.span1 * (self.du1 * phi + self.u1_start - self.n1)
+        al2 = self.al2_in + self.span2 * (self.du2 * phi + self.u2_start - self.n2)
         return al1, al2
 
     # -- coefficients -------------------------------------------------------------------
@@ -276,10 +298,9 @@ class TrainPhysics:
     def _parts(self, phi: float, phi_dot: float) -> tuple[float, ...]:
         d = self.d
         mu, dn, a15c, a16, a31c, a42c, a43, a44c, _, _, _, _ = self._k
-        u1 = self.du1 * phi + d.j1 - self.n1
-        u2 = self.du2 * phi + d.j2 - self.n2
-        a1 = (self.al1_in + self.range1 * u1) * d.rb1_cap
-        a2 = (self.al2_in + self.range2 * u2) * d.rb2_cap
+        al1, al2 = self.mesh_alphas(phi)
+        a1 = al1 * d.rb1_cap
+        a2 = al2 * d.rb2_cap
         a15 = a15c - mu * self.s2 * (self.d2 - a2)
         a31 = a31c - mu * self.s1 * a1
         a42 = a42c - mu * self.s1 * (self.d1 - a1)

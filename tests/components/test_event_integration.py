@@ -110,3 +110,76 @@ def test_bad_controls_are_refused() -> None:
     for rtol, h_max in ((0.0, 1.0), (2.0, 1.0), (1e-6, 0.0), (math.nan, 1.0)):
         with pytest.raises(ComponentError):
             StepControl(rtol, (1.0,), h_max)
+
+
+class TwoClocks:
+    """y' = 1 from 0; indicators 1 - y and 1 - y (one instant, t = 1) and 2 - y (t = 2).
+    Each event is logged with its index and time; it changes nothing."""
+
+    def __init__(self) -> None:
+        self.fired: list[tuple[int, float]] = []
+
+    def deriv(self, y: list[float]) -> list[float]:
+        return [1.0]
+
+    def indicators(self, y: list[float]) -> tuple[float, float, float]:
+        return (1.0 - y[0], 1.0 - y[0], 2.0 - y[0])
+
+    def event(self, y: list[float], index: int, t: float) -> list[float]:
+        self.fired.append((index, t))
+        return y
+
+
+def test_two_indicators_crossing_at_one_instant_both_fire() -> None:
+    model = TwoClocks()
+    done = advance(model, [0.0], 3.0, StepControl(1e-8, (1.0,)), tol_t=1e-13)
+    assert [i for i, _ in model.fired] == [0, 1, 2]  # index order at one instant
+    (_, t0), (_, t1), (_, t2) = model.fired
+    assert t0 == t1 == pytest.approx(1.0, abs=1e-12)
+    assert t2 == pytest.approx(2.0, abs=1e-12)
+    assert done.events == 3
+
+
+class StopOnTheMark:
+    """A wheel that runs at unit speed.  Index 0: a mark every 1 (the hand-over, which
+    re-indexes the mark and moves a stop indicator 1 - k/2 its change of state leaves past
+    zero at t = 2); index 1: the stop."""
+
+    def __init__(self) -> None:
+        self.mark = 1.0
+        self.stop_at = 5.0
+        self.fired: list[tuple[int, float]] = []
+        self.halted = False
+
+    def deriv(self, y: list[float]) -> list[float]:
+        return [1.0]
+
+    def indicators(self, y: list[float]) -> tuple[float, float]:
+        return (self.mark - y[0], self.stop_at - y[0])
+
+    def event(self, y: list[float], index: int, t: float) -> list[float]:
+        self.fired.append((index, t))
+        if index == 0:
+            self.mark += 1.0
+            if self.mark > 2.5:  # the hand-over at t = 2 moves the stop behind the wheel
+                self.stop_at = 1.9
+        else:
+            self.halted = True
+        return y
+
+
+def test_an_event_that_leaves_another_indicator_past_zero_fires_it() -> None:
+    model = StopOnTheMark()
+    done = advance(model, [0.0], 10.0, StepControl(1e-8, (1.0,)), tol_t=1e-13)
+    assert [i for i, _ in model.fired] == [0, 0, 1]
+    assert [t for _, t in model.fired] == pytest.approx([1.0, 2.0, 2.0], abs=1e-12)
+    assert model.halted
+    assert done.y[0] == pytest.approx(2.0, abs=1e-12)  # stopped where it fired
+
+
+def test_an_indicator_negative_before_the_step_does_not_fire() -> None:
+    """Only indicators armed (>= 0) at the step start can fire at an event's instant."""
+    model = StopOnTheMark()
+    model.stop_at = -1.0  # behind the wheel from the start: never armed
+    advance(model, [0.0], 3.5, StepControl(1e-8, (1.0,)), tol_t=1e-13)
+    assert [i for i, _ in model.fired] == [0, 0, 0]

@@ -300,6 +300,91 @@ def test_impacts_and_regime_log(nominal):
     assert whys == {"tooth left the face end (g = 0)"}
 
 
+# Turns to arm of the converged monolithic model at 30,000 rpm, mu1 = 0.1 (measured).  With
+# per-pitch hand-over they differ from the former range-per-cycle rule by 1.8e-4 (train
+# mu = 0.1) and 1.6e-4 (mu1 = 0); without train friction the hand-over carries no load
+# difference and the value is the former one to 1e-9 (20.651031036 before the change).
+TURNS_NOMINAL = 25.914572675
+TURNS_MU1_ZERO = 24.693435351
+TURNS_TRAIN_FRICTIONLESS = 20.651031036
+
+
+def test_turns_to_arm_with_per_pitch_hand_over(nominal):
+    assert nominal.turns == pytest.approx(TURNS_NOMINAL, rel=1e-8)
+    r = run_m739(mu1=0.0)
+    assert r.armed, r.reason
+    assert r.turns == pytest.approx(TURNS_MU1_ZERO, rel=1e-8)
+
+
+def test_frictionless_train_does_not_depend_on_the_hand_over():
+    physical = run_m739(mu=0.0)
+    assert physical.turns == pytest.approx(TURNS_TRAIN_FRICTIONLESS, rel=1e-9)
+    as_run = run_m739(mu=0.0, indexing=INDEXING_AS_RUN)
+    assert as_run.turns == pytest.approx(physical.turns, rel=1e-8)
+
+
+@pytest.fixture(scope="module")
+def hand_overs(monkeypatch_module):
+    """The nominal run with every mesh event recorded: (phi, n1, n2) after each one, and
+    the train physics at the end."""
+    seen: list[tuple[float, int, int]] = []
+    trains: list[TrainPhysics] = []
+    on_event, init = TrainPhysics.on_mesh_event, TrainPhysics.__init__
+
+    def record(self, phi):
+        on_event(self, phi)
+        seen.append((phi, self.n1, self.n2))
+
+    def keep(self, *args, **kwargs):
+        init(self, *args, **kwargs)
+        trains.append(self)
+
+    monkeypatch_module.setattr(TrainPhysics, "on_mesh_event", record)
+    monkeypatch_module.setattr(TrainPhysics, "__init__", keep)
+    result = run_m739()
+    return result, seen, trains[-1]
+
+
+@pytest.fixture(scope="module")
+def monkeypatch_module():
+    with pytest.MonkeyPatch.context() as mp:
+        yield mp
+
+
+def test_hand_over_once_per_tooth_pitch(hand_overs):
+    """Mesh 2 hands over every 2 pi/N_P3 = 45 deg of phi, mesh 1 every 2 pi/(N_P2 |N32|) =
+    180 deg (Tepper 1981, eq. 24: one base pitch per cycle), over the whole run."""
+    result, seen, train = hand_overs
+    assert result.armed, result.reason
+    pitch2 = 2.0 * math.pi / M739.np3
+    pitch1 = 2.0 * math.pi / (M739.np2 * abs(M739.n32))
+    assert pitch2 / DEG == pytest.approx(45.0, rel=1e-15)
+    assert pitch1 / DEG == pytest.approx(180.0, rel=1e-15)
+    for mesh, pitch, count in ((1, pitch1, 8), (2, pitch2, 33)):
+        changes = [
+            phi for k, (phi, *n) in enumerate(seen) if k > 0 and n[mesh - 1] != seen[k - 1][mesh]
+        ]
+        assert len(changes) == count, mesh
+        for j, phi in enumerate(changes, start=1):
+            assert phi == pytest.approx(j * pitch, abs=1e-9), (mesh, j)
+
+
+def test_mesh_phase_at_arming_is_phi_modulo_the_pitch(hand_overs):
+    """Arming (1485 deg = 33 x 45 deg) falls on a mesh-2 hand-over: both events fire, the
+    run arms, and each roll angle is alpha_in + |N3i| (phi mod pitch) on the new pair."""
+    result, _, train = hand_overs
+    assert result.armed, result.reason
+    phi = result.phi_end
+    assert phi == pytest.approx(M739.phi_cut, abs=1e-9)
+    assert (train.n1, train.n2) == (8, 33)
+    al1, al2 = train.mesh_alphas(phi)
+    pitch1 = 2.0 * math.pi / (M739.np2 * abs(M739.n32))
+    pitch2 = 2.0 * math.pi / M739.np3
+    assert al2 == pytest.approx(train.al2_in + abs(M739.n32) * (phi - 33 * pitch2), abs=1e-12)
+    assert al1 == pytest.approx(train.al1_in + M739.n31 * (phi - 8 * pitch1), abs=1e-12)
+    assert abs(phi - 33 * pitch2) < 1e-9  # on the hand-over itself
+
+
 @pytest.mark.parametrize("mu, turns", [(0.05, 22.0), (0.15, 31.0)])
 def test_friction_sensitivity(mu, turns):
     r = run_m739(mu=mu, mu1=mu)
