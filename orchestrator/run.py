@@ -8,7 +8,6 @@ to then is kept on disk and in the result.
 from __future__ import annotations
 
 import platform
-import subprocess
 import time
 import warnings
 from collections.abc import Iterator
@@ -30,13 +29,12 @@ from orchestrator.interrupt import Interrupted, SignalGuard, catching_signals, s
 from orchestrator.masters import MASTERS
 from orchestrator.output_lock import OutputLock
 from orchestrator.progress import ProgressBar
+from orchestrator.provenance import source_commit
 from orchestrator.recorder import Recorder, StepStats
 from orchestrator.scenario import Scene
 from orchestrator.scenes import ANALYSES, PLOTS, REFERENCES
 from orchestrator.scenes.family import Reference
 from orchestrator.system import CoupledSystem
-
-PROJECT_DIR = Path(__file__).resolve().parent.parent
 
 
 @dataclass
@@ -307,16 +305,6 @@ def _metadata(scene: Scene, fmu_paths: dict[str, Path]) -> dict[str, Any]:
         "stop": scene.stop,
         "python": platform.python_version(),
         "versions": versions,
-        "commit": _git_commit(),
+        "commit": source_commit(),
         "date": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
     }
-
-
-def _git_commit() -> str | None:
-    try:
-        out = subprocess.run(
-            ["git", "rev-parse", "HEAD"], cwd=PROJECT_DIR, capture_output=True, text=True, timeout=5
-        )
-    except (OSError, subprocess.TimeoutExpired):
-        return None
-    return out.stdout.strip() or None

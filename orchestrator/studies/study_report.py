@@ -73,7 +73,9 @@ def write_markdown(result: StudyResult, path: Path) -> None:
         + f"; {spec.sampling} sampling, seed {spec.seed}; master {master}. "
         + "Run time: "
         + "; ".join(
-            f"{r['samples_run']} samples in {r['wall_time']:.1f} s ({r['where']})"
+            f"{r['samples_run']} samples in {r['wall_time']:.1f} s ({r['where']}"
+            + (f", commit {r['commit']}" if r.get("commit") else "")
+            + ")"
             for r in result.invocations
             if r["samples_run"]
         )

@@ -30,6 +30,7 @@ import numpy as np
 from orchestrator.errors import ScenarioError
 from orchestrator.interrupt import catching_signals
 from orchestrator.progress import ProgressBar
+from orchestrator.provenance import source_changed, source_commit
 from orchestrator.scenario import Scene, load_scene
 from orchestrator.studies.jobs import Job, JobResult, iter_jobs
 from orchestrator.studies.sampling import draw, unit_points
@@ -245,7 +246,10 @@ def _log_invocation(
             log = json.loads(path.read_text())
         except (OSError, ValueError):
             log = []
-    log.append({"samples_run": ran, "wall_time": round(wall, 3), "where": where})
+    commit = source_commit()
+    if commit and source_changed():
+        commit += " with uncommitted changes"
+    log.append({"samples_run": ran, "wall_time": round(wall, 3), "where": where, "commit": commit})
     path.write_text(json.dumps(log, indent=1) + "\n")
     return log
 

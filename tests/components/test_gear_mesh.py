@@ -180,6 +180,26 @@ def test_regime_switches_at_contact_angles(printed: int, alfin_deg: float) -> No
         assert sides[0] * sides[1] < 0.0, name
 
 
+@pytest.mark.parametrize("mesh", range(1, 10))
+def test_a_new_pair_takes_over_once_per_base_pitch(mesh: int) -> None:
+    """Over three cycles of each of the nine meshes, a new pair enters (single -> dual
+    contact) every base pitch of driver roll, p_b / R_b (eq. 24), never every contact range."""
+    c = make(mu=0.1, speed=5.0, mesh=mesh, printed_run=0)
+    geom = c._cache_model.geometry
+    assert geom.cycle_angle * geom.driver_base_radius == pytest.approx(geom.base_pitch, rel=1e-15)
+    switches = run_to(c, 3.2 * geom.cycle_angle / c.speed, 160)
+    entries = [
+        te
+        for k, (r, te) in enumerate(switches)
+        if r not in (SINGLE_APPROACH, SINGLE_RECESS)
+        and k > 0
+        and switches[k - 1][0] in (SINGLE_APPROACH, SINGLE_RECESS)
+    ]
+    assert len(entries) == 3, switches
+    gaps = np.diff([geom.alpha_in + c.speed * te for te in entries])
+    assert gaps == pytest.approx(geom.cycle_angle, abs=1e-12)
+
+
 def test_end_of_dual_contact_error_effect() -> None:
     """The printed ALFIN (13.948 deg) puts 14.03 and 14.93 deg in single contact; the physical
     one (15.215 deg) keeps them dual: the minimum at mu = 0.3 rises from .6526 to the plateau."""

@@ -216,6 +216,31 @@ def test_handover_is_continuous_in_position_and_an_inelastic_impact(mesh: int) -
     assert before[0] < new[0]
 
 
+def test_handovers_are_one_pinion_pitch_apart_over_a_whole_run(monkeypatch) -> None:
+    """Every handover of a whole arming run: mesh 2 hands over each escape-pinion pitch of
+    the wheel angle, mesh 1 each pinion-2 pitch of the cluster angle (the pieces are cut per
+    tooth, not per contact range, so the phase cannot drift)."""
+    seen: list[tuple[float, int, int, float]] = []
+    cross = ClockTrainPhysics.cross
+
+    def record(self, phi, phi_dot, j_load=0.0):
+        out = cross(self, phi, phi_dot, j_load)
+        seen.append((phi, self.pieces[0][0], self.pieces[1][0], self.evaluate(phi)[1]))
+        return out
+
+    monkeypatch.setattr(ClockTrainPhysics, "cross", record)
+    result = run_clock_train(mu=0.0, mu1=0.0)
+    assert result.armed, result.reason
+    m1, m2 = M739_TRAIN.mesh1, M739_TRAIN.mesh2
+    for mesh, pitch, position in ((1, m1.pinion_pitch, 3), (2, m2.pinion_pitch, 0)):
+        at = [
+            row[position] for k, row in enumerate(seen) if k > 0 and row[mesh] != seen[k - 1][mesh]
+        ]
+        assert len(at) >= 4, mesh
+        gaps = np.abs(np.diff(at))
+        assert gaps == pytest.approx(pitch, abs=1e-9), mesh
+
+
 def test_sticks_between_the_friction_limits_and_backdrives_beyond() -> None:
     phys = ClockTrainPhysics(mu=0.1)
     _at(phys, 0.0, 1)
