@@ -138,3 +138,47 @@ def test_free_flight_restarts_at_a_quarter_of_the_step_it_reached(tmp_path, fmu_
     phi = remembered.header.index("train.phi")
     assert remembered.data[-1, phi] == pytest.approx(ramp.data[-1, phi], rel=1e-6)
     assert remembered.stats.do_steps < 0.95 * ramp.stats.do_steps
+
+
+TWIN_MESHES = """
+[scene]
+name = "twin_meshes"
+stop = "0.12 s"
+
+[fmus.a]
+component = "GearMesh"
+parameters = { model = 1, mesh = 2, printed_run = 0, mu = 0.1, speed = "100 rpm" }
+inputs = { load_torque = "1 lbf*in" }
+
+[fmus.b]
+component = "GearMesh"
+parameters = { model = 1, mesh = 2, printed_run = 0, mu = 0.2, speed = "100 rpm" }
+inputs = { load_torque = "2 lbf*in" }
+
+[master]
+algorithm = "regime-aware"
+step = "10 us"
+event_tolerance = "1e-10 s"
+"""
+
+
+def test_two_fmus_switching_at_one_instant_both_switch_there(tmp_path, fmu_cache) -> None:
+    """Two meshes of one geometry at one speed change contact phase at the same instants:
+    the master lands once on each instant and logs both switches there, none lost."""
+    path = tmp_path / "twin_meshes.toml"
+    path.write_text(TWIN_MESHES)
+    result = run_scene(
+        load_scene(path, {}),
+        output_dir=tmp_path / "run",
+        cache_dir=fmu_cache,
+        show_progress=False,
+        plots=False,
+    )
+    assert result.status == "completed", result.message
+    by_fmu: dict[str, list[tuple[float, str, str]]] = {"a": [], "b": []}
+    for t, who, old, new in result.events:
+        by_fmu[who].append((t, old, new))
+    assert len(by_fmu["a"]) >= 9  # three phase changes per base pitch, three pitches
+    assert [(o, n) for _, o, n in by_fmu["a"]] == [(o, n) for _, o, n in by_fmu["b"]]
+    for (ta, _, _), (tb, _, _) in zip(by_fmu["a"], by_fmu["b"], strict=True):
+        assert ta == tb  # one landing, both logged at it
