@@ -159,6 +159,7 @@ def run_study(
         where = f"{workers} workers" if workers else "one worker per core"
     units: dict[str, str] = {}
     start = time.perf_counter()
+    commit = _source_description()
     interrupted: int | None = None
     bar = ProgressBar(
         total=n, initial=len(done), unit="sample", disable=not show_progress, desc=scene.name
@@ -185,7 +186,7 @@ def run_study(
     bar.close()
     wall = time.perf_counter() - start
     _rewrite(csv_path, spec, done)
-    invocations = _log_invocation(out_dir, resume, len(done) - (n - len(todo)), wall, where)
+    invocations = _log_invocation(out_dir, resume, len(done) - (n - len(todo)), wall, where, commit)
     result = StudyResult(
         scene,
         spec,
@@ -234,8 +235,16 @@ def _sample(k: int, inputs: np.ndarray, outcome: Any, spec: StudySpec) -> Sample
     return Sample(k, row, OK, values)
 
 
+def _source_description() -> str | None:
+    """The commit the study runs from (taken at its start), marked if the tree differs."""
+    commit = source_commit()
+    if commit and source_changed():
+        commit += " with uncommitted changes"
+    return commit
+
+
 def _log_invocation(
-    out_dir: Path, resume: bool, ran: int, wall: float, where: str
+    out_dir: Path, resume: bool, ran: int, wall: float, where: str, commit: str | None
 ) -> list[dict[str, Any]]:
     """Append this invocation to ``runs.json`` (started afresh unless resuming): the
     study's run time, which samples.csv leaves out to stay the same wherever it ran."""
@@ -246,9 +255,6 @@ def _log_invocation(
             log = json.loads(path.read_text())
         except (OSError, ValueError):
             log = []
-    commit = source_commit()
-    if commit and source_changed():
-        commit += " with uncommitted changes"
     log.append({"samples_run": ran, "wall_time": round(wall, 3), "where": where, "commit": commit})
     path.write_text(json.dumps(log, indent=1) + "\n")
     return log
