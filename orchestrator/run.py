@@ -25,9 +25,9 @@ from fmus.build import build_fmu
 from orchestrator.accuracy import compare
 from orchestrator.analyses import energy_residual, headline, missing_column
 from orchestrator.errors import RunError
+from orchestrator.execution import execute
 from orchestrator.fmu_instance import file_sha256
 from orchestrator.interrupt import Interrupted, SignalGuard, catching_signals, signal_name
-from orchestrator.masters import MASTERS
 from orchestrator.output_lock import OutputLock
 from orchestrator.progress import ProgressBar
 from orchestrator.recorder import Recorder, StepStats
@@ -127,18 +127,13 @@ def _run_locked(
         guard.check()
         system.initialize()
         guard.check()
-        MASTERS[scene.master.algorithm](system, scene, recorder, stats, progress)
+        execute(system, scene, recorder, stats, progress)
     except RunError as exc:
         status, message = "failed", str(exc)
         if exc.time is not None:
             reached[0] = exc.time
     except Interrupted as exc:
-        status = "interrupted"
-        if recorder.rows and recorder.rows[-1][0] < reached[0]:
-            try:  # the values at the step boundary reached (a thinned record may lack it)
-                recorder.row(system.record_row(reached[0]))
-            except RunError:
-                pass
+        status = "interrupted"  # the loop kept the values at the step boundary reached
         message = (
             f"{exc}: stopped at t = {reached[0]:.9g} s (simulated); everything up to there is kept"
         )

@@ -39,8 +39,10 @@ from typing import Any
 
 from orchestrator.errors import RunError
 from orchestrator.master_settings import RegimeAwareSettings
-from orchestrator.masters.fixed_step import run_fixed_step_scene
-from orchestrator.recorder import Recorder, RegimeLog, StepStats
+from orchestrator.masters.fixed_step import fixed_step_master
+from orchestrator.masters.macro_step import MacroStep, Master
+from orchestrator.observers import regime_changes
+from orchestrator.recorder import StepStats
 from orchestrator.scenario import Scene
 from orchestrator.system import CoupledSystem
 
@@ -61,16 +63,14 @@ class RegimeAwareMaster:
         self,
         system: CoupledSystem,
         settings: RegimeAwareSettings,
-        start: float,
-        stop: float,
-        recorder: Recorder,
         stats: StepStats,
     ):
-        self.system, self.recorder, self.stats = system, recorder, stats
+        self.system, self.stats = system, stats
         self.cfg, self.control = settings, settings.control
-        self.start, self.stop = start, stop
         self.names = system.names
-        self.log = RegimeLog(system, recorder)
+        self.h = settings.first_step  # the step the next macro step tries first
+        self.same_instant = 0  # switches in a row within one instant (chattering guard)
+        self.last_change: tuple[str, str, str] | None = None  # (FMU, from, to), last seen
         # Exchanged Real signals held over a step: (instance, slot) of their sources.  Inputs
         # that are sampled as a state at the step start carry no hold error of their own.
         # Midpoint hold: per instance, its Real inputs in feed order as (source, averaged?);
@@ -292,59 +292,58 @@ class RegimeAwareMaster:
             f" in {self.cfg.max_iterations} rounds"
         )
 
-    def log_switches(self, t: float, before: _Snapshot) -> int:
-        self.log.last = before.regimes
-        return self.log.update(t)
+    def _note_changes(self, before: _Snapshot) -> None:
+        """Remember the last regime change since ``before`` (the chattering diagnosis)."""
+        changes = regime_changes(self.system, before.regimes, self.system.regimes())
+        if changes:
+            self.last_change = changes[-1]
 
-    # -- main loop --------------------------------------------------------------------
-    def run(self, progress) -> None:
-        cfg, system, stats, recorder = self.cfg, self.system, self.stats, self.recorder
+    # -- one macro step (the execution loop calls it) ---------------------------------
+    def step(self, t: float, stop: float) -> MacroStep:
+        """One accepted macro step from t: onto the first switch inside it (then the
+        exchange there is settled), or as long as the error test allows."""
+        cfg, system, stats = self.cfg, self.system, self.stats
         control = self.control
-        t, stop = self.start, self.stop
-        h = cfg.first_step
-        recorder.row(system.record_row(t))
-        same_instant = 0
-        while t < stop - control.stop_slack * max(1.0, abs(stop)):
-            h = min(h, stop - t)
-            state = system.get_state()
-            before = self.snapshot()  # consistent: every trial and settle ends refreshed
-            try:
-                h, te = self._attempt(t, h, before, state)
-                if te is not None:
-                    left = self._left_values(t, te, h, state, before)
-            finally:
-                system.free_state(state)
-                self.free_predictor_states()
-            t += h
-            stats.steps += 1
-            if te is None:
-                ratio = self.step_ratio(before)
-                stats.events += self.log_switches(t - h, before)  # switched at the start
-                recorder.row(system.record_row(t))
-                h = min(cfg.max_step, h * control.grow(ratio, self.first_order))
-                self._remember_step(tuple(before.regimes), ratio, h)
-                same_instant = 0
-            else:
-                if left is not None:
-                    recorder.row(left)  # values just before the switch
-                stats.iterations += self.settle() - 1
-                stats.events += max(self.log_switches(t, before), 1)
-                recorder.row(system.record_row(t))  # values just after the switch
-                window = self.instant
-                same_instant = same_instant + 1 if h <= window else 0
-                if same_instant > cfg.max_events_per_step:
-                    raise RunError(
-                        f"chattering: {same_instant} switches within "
-                        f"{window:.1e} s of each other; "
-                        f"last in {self._last_switch()}",
-                        t,
-                    )
-                h = self._restart_step(tuple(system.regimes()))
-            progress(t)
-            stop_indicator = system.stop_indicator()
-            if stop_indicator is not None and stop_indicator <= 0.0:
-                stats.extra["stopped_by_condition"] = True
-                return
+        h = min(self.h, stop - t)
+        state = system.get_state()
+        before = self.snapshot()  # consistent: every trial and settle ends refreshed
+        try:
+            h, te = self._attempt(t, h, before, state)
+            if te is not None:
+                left = self._left_values(t, te, h, state, before)
+        finally:
+            system.free_state(state)
+            self.free_predictor_states()
+        end = t + h
+        if te is None:
+            ratio = self.step_ratio(before)
+            self._note_changes(before)
+            self.h = min(cfg.max_step, h * control.grow(ratio, self.first_order))
+            self._remember_step(tuple(before.regimes), ratio, self.h)
+            self.same_instant = 0
+            # A regime that changed without a located switch changed at the step start.
+            return MacroStep(end, h, changes_at=t, regimes_before=before.regimes)
+        stats.iterations += self.settle() - 1
+        self._note_changes(before)
+        failure = None
+        window = self.instant
+        self.same_instant = self.same_instant + 1 if h <= window else 0
+        if self.same_instant > cfg.max_events_per_step:
+            failure = RunError(
+                f"chattering: {self.same_instant} switches within "
+                f"{window:.1e} s of each other; "
+                f"last in {self._last_switch()}",
+                end,
+            )
+        self.h = self._restart_step(tuple(system.regimes()))
+        return MacroStep(
+            end,
+            h,
+            switched=True,
+            regimes_before=before.regimes,
+            left_row=left,  # values just before the switch
+            failure=failure,
+        )
 
     def _remember_step(self, regimes: tuple[int | None, ...], ratio: float, h: float) -> None:
         """Keep the step proposed after an accepted one in ``regimes`` while no step there
@@ -485,9 +484,9 @@ class RegimeAwareMaster:
         self.stats.rejections += 1
 
     def _last_switch(self) -> str:
-        if not self.recorder.events:
+        if self.last_change is None:
             return "no FMU"
-        t, sub, a, b = self.recorder.events[-1]
+        sub, a, b = self.last_change
         return f"FMU {sub!r} ({a} -> {b})"
 
 
@@ -498,9 +497,9 @@ def _same(a: list[float], b: list[float]) -> bool:
     )
 
 
-def run_regime_aware(
-    system: CoupledSystem, scene: Scene, recorder: Recorder, stats: StepStats, progress
-) -> None:
+def regime_aware(system: CoupledSystem, scene: Scene, stats: StepStats) -> Master:
+    """The regime-aware master of ``scene``; fixed-step Jacobi where an FMU cannot save and
+    restore its state."""
     blind = [n for n, m in zip(system.names, system.models, strict=True) if not m.can_get_set_state]
     if blind:
         # Without rollback no trial can be taken back: say what is given up, and couple
@@ -512,11 +511,5 @@ def run_regime_aware(
             f"master.step = {scene.master.step:g} s (no error control, switches seen only "
             "at communication points)"
         )
-        run_fixed_step_scene(
-            system, scene, scene.master.step, recorder, stats, progress, sequential=False
-        )
-        return
-    master = RegimeAwareMaster(
-        system, scene.master.settings, scene.start, scene.stop, recorder, stats
-    )
-    master.run(progress)
+        return fixed_step_master(system, scene, stats, scene.master.step, sequential=False)
+    return RegimeAwareMaster(system, scene.master.settings, stats)

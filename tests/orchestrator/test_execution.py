@@ -1,0 +1,156 @@
+"""The execution loop every master shares: the fixed-step masters record exactly what a
+hand-written Jacobi / Gauss–Seidel loop records, and ``output.every`` thins the record of
+every master without changing what it computes."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import pytest
+
+from orchestrator import execution
+from orchestrator.master_settings import ALGORITHMS
+from orchestrator.run import fmu_files, run_scene
+from orchestrator.scenario import load_scene
+from orchestrator.system import CoupledSystem
+
+SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
+STOP_AT_ONE_RADIAN = {"signal": "a.phi", "above": "1 rad"}
+
+
+def _run(tmp_path, fmu_cache, scene, name):
+    return run_scene(
+        scene,
+        output_dir=tmp_path / name,
+        cache_dir=fmu_cache,
+        show_progress=False,
+        plots=False,
+        compare_reference=False,
+    )
+
+
+def _by_hand(scene, fmu_cache, sequential: bool):
+    """The record of a fixed-step run written out as one loop (as each master ran its own
+    before the loop was shared): rows every ``output.every`` steps, the regime changes
+    logged at the step end, the step that meets ``stop_when`` the last."""
+    system = CoupledSystem(scene, fmu_files(scene, fmu_cache))
+    try:
+        system.initialize()
+        h, start, stop = scene.master.step, scene.start, scene.stop
+        n = math.ceil((stop - start) / h - 1e-9)
+        m = len(system.instances)
+        rows, events = [system.record_row(start)], []
+        names = [model.regime_names for model in system.models]
+        last = system.regimes()
+        t = start
+        for k in range(n):
+            hk = h if k < n - 1 else stop - t
+            for i in range(m):
+                system.feed(i)
+                system.step(i, t, hk)
+                if sequential:
+                    system.read(i)
+            if not sequential:
+                system.read_all()
+            t = start + (k + 1) * h if k < n - 1 else stop
+            now = system.regimes()
+            for i, (a, b) in enumerate(zip(last, now, strict=True)):
+                if a != b:
+                    events.append(
+                        (t, system.names[i], names[i].get(a, str(a)), names[i].get(b, str(b)))
+                    )
+            last = now
+            g = system.stop_indicator()
+            done = g is not None and g <= 0.0
+            if (k + 1) % scene.record_every == 0 or k == n - 1 or done:
+                rows.append(system.record_row(t))
+            if done:
+                break
+        return rows, events, k + 1
+    finally:
+        system.close()
+
+
+@pytest.mark.parametrize(
+    ("algorithm", "file", "overrides"),
+    [
+        ("jacobi", "two_inertias.toml", {}),
+        ("gauss-seidel", "two_inertias.toml", {}),
+        ("jacobi", "two_inertias.toml", {"output.every": 7, "scene.stop_when": STOP_AT_ONE_RADIAN}),
+        ("gauss-seidel", "press_feed_run1.toml", {"scene.stop": "0.3 s", "output.every": 3}),
+        ("jacobi", "press_feed_run1.toml", {"scene.stop": "0.3 s"}),
+    ],
+)
+def test_fixed_step_masters_record_what_one_hand_written_loop_records(
+    tmp_path, fmu_cache, algorithm, file, overrides
+) -> None:
+    scene = load_scene(SCENARIOS / file, {"master.algorithm": algorithm, **overrides})
+    rows, events, steps = _by_hand(scene, fmu_cache, sequential=algorithm == "gauss-seidel")
+    result = _run(tmp_path, fmu_cache, scene, "run")
+    assert result.status == "completed"
+    assert result.stats.steps == steps and result.stats.do_steps == steps * len(scene.fmus)
+    assert result.data.tolist() == rows  # bit for bit
+    assert [(t, s, a, b) for t, s, a, b in result.events] == events
+    if "scene.stop_when" in overrides:
+        assert result.stats.extra["stopped_by_condition"]
+
+
+class _Spy:
+    """Wraps a master factory: keeps every MacroStep the masters of a run return."""
+
+    def __init__(self, factory) -> None:
+        self.factory, self.steps = factory, []
+
+    def __call__(self, system, scene, stats):
+        master = self.factory(system, scene, stats)
+        step = master.step
+
+        def spied(t, stop):
+            taken = step(t, stop)
+            self.steps.append(taken)
+            return taken
+
+        master.step = spied
+        return master
+
+
+def _scene_for(algorithm: str, every: int):
+    if algorithm in ("jacobi", "gauss-seidel"):
+        overrides = {"master.algorithm": algorithm, "scene.stop": "0.1 s"}
+        return load_scene(SCENARIOS / "two_inertias.toml", overrides | {"output.every": every})
+    # The M739's first 4 ms: a dozen escapement switches, each recorded on both sides.
+    overrides = {"scene.stop": "4 ms", "master.tolerance": 1e-2, "output.every": every}
+    return load_scene(SCENARIOS / "m739.toml", overrides)
+
+
+@pytest.mark.parametrize("algorithm", ALGORITHMS)
+def test_output_every_thins_the_record_of_every_master(
+    tmp_path, fmu_cache, monkeypatch, algorithm
+) -> None:
+    """Every 7th macro step and the last are recorded (a step onto a switch with its values
+    just before it); the run itself, its statistics and its events are those of the full
+    record, and each recorded row is the full record's row, bit for bit."""
+    spy = _Spy(execution.MASTERS[algorithm])
+    monkeypatch.setitem(execution.MASTERS, algorithm, spy)
+    full = _run(tmp_path, fmu_cache, _scene_for(algorithm, 1), "full")
+    steps, spy.steps = spy.steps, []
+    thinned = _run(tmp_path, fmu_cache, _scene_for(algorithm, 7), "thinned")
+    assert full.status == thinned.status == "completed"
+    assert [(s.end, s.h) for s in spy.steps] == [(s.end, s.h) for s in steps]
+    assert len(steps) == full.stats.steps > 20
+    if algorithm == "regime-aware":
+        assert sum(s.switched for s in steps) >= 10
+        assert any(s.left_row is not None for s in steps[6::7])  # a switch among those kept
+    for key in ("steps", "do_steps", "rejections", "rollbacks", "iterations", "events"):
+        assert getattr(thinned.stats, key) == getattr(full.stats, key), key
+    assert thinned.events == full.events
+    expected = [thinned.scene.start]
+    for k, s in enumerate(steps, start=1):
+        if k % 7 == 0 or k == len(steps):
+            expected += ([s.left_row[0]] if s.left_row is not None else []) + [s.end]
+    assert thinned.signal("time").tolist() == expected
+    rows = {tuple(row) for row in full.data.tolist()}
+    assert all(tuple(row) in rows for row in thinned.data.tolist())
+    assert thinned.data[-1].tolist() == full.data[-1].tolist()
+    assert len(full.data) == 1 + len(steps) + sum(s.left_row is not None for s in steps)
