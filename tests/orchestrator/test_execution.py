@@ -9,8 +9,9 @@ from pathlib import Path
 
 import pytest
 
-from orchestrator import execution
-from orchestrator.master_settings import ALGORITHMS
+from orchestrator import execution, scenario
+from orchestrator.master_settings import ALGORITHMS, SETTINGS, TOLERANCE_MASTERS, FixedStepSettings
+from orchestrator.masters import MacroStep
 from orchestrator.run import fmu_files, run_scene
 from orchestrator.scenario import load_scene
 from orchestrator.system import CoupledSystem
@@ -116,11 +117,11 @@ class _Spy:
 
 
 def _scene_for(algorithm: str, every: int):
-    if algorithm in ("jacobi", "gauss-seidel"):
-        overrides = {"master.algorithm": algorithm, "scene.stop": "0.1 s"}
-        return load_scene(SCENARIOS / "two_inertias.toml", overrides | {"output.every": every})
+    overrides = {"master.algorithm": algorithm, "output.every": every}
+    if algorithm not in TOLERANCE_MASTERS:
+        return load_scene(SCENARIOS / "two_inertias.toml", overrides | {"scene.stop": "0.1 s"})
     # The M739's first 4 ms: a dozen escapement switches, each recorded on both sides.
-    overrides = {"scene.stop": "4 ms", "master.tolerance": 1e-2, "output.every": every}
+    overrides |= {"scene.stop": "4 ms", "master.tolerance": 1e-2}
     return load_scene(SCENARIOS / "m739.toml", overrides)
 
 
@@ -139,7 +140,7 @@ def test_output_every_thins_the_record_of_every_master(
     assert full.status == thinned.status == "completed"
     assert [(s.end, s.h) for s in spy.steps] == [(s.end, s.h) for s in steps]
     assert len(steps) == full.stats.steps > 20
-    if algorithm == "regime-aware":
+    if algorithm in TOLERANCE_MASTERS:
         assert sum(s.switched for s in steps) >= 10
         assert any(s.left_row is not None for s in steps[6::7])  # a switch among those kept
     for key in ("steps", "do_steps", "rejections", "rollbacks", "iterations", "events"):
@@ -154,3 +155,64 @@ def test_output_every_thins_the_record_of_every_master(
     assert all(tuple(row) in rows for row in thinned.data.tolist())
     assert thinned.data[-1].tolist() == full.data[-1].tolist()
     assert len(full.data) == 1 + len(steps) + sum(s.left_row is not None for s in steps)
+
+
+class _HalfStepJacobi:
+    """A master as README's "Adding a master" describes one: Jacobi steps of half
+    ``master.step``, with nothing but the stepping."""
+
+    def __init__(self, system, scene, stats) -> None:
+        self.system, self.stats = system, stats
+        self.h = 0.5 * scene.master.settings.step
+
+    def step(self, t: float, stop: float) -> MacroStep:
+        h = stop - t if stop - t < 1.5 * self.h else self.h  # no sliver of a last step
+        for i in range(len(self.system.instances)):
+            self.system.feed(i)
+            self.system.step(i, t, h)
+        self.system.read_all()
+        self.stats.do_steps += len(self.system.instances)
+        return MacroStep(t + h, h)
+
+
+def test_a_new_master_is_its_stepping_and_its_settings(tmp_path, fmu_cache, monkeypatch) -> None:
+    """Registered with its settings, a master that only steps gets the rest from the loop:
+    the stop time, the stop condition, the thinned record, the regime log and the counts."""
+    monkeypatch.setitem(SETTINGS, "half-jacobi", FixedStepSettings)
+    monkeypatch.setitem(execution.MASTERS, "half-jacobi", _HalfStepJacobi)
+    monkeypatch.setattr(scenario, "ALGORITHMS", (*ALGORITHMS, "half-jacobi"))
+    overrides = {"scene.stop": "0.1 s", "output.every": 4}
+    half = _run(
+        tmp_path,
+        fmu_cache,
+        load_scene(
+            SCENARIOS / "two_inertias.toml", overrides | {"master.algorithm": "half-jacobi"}
+        ),
+        "half",
+    )
+    jacobi = _run(
+        tmp_path,
+        fmu_cache,
+        load_scene(
+            SCENARIOS / "two_inertias.toml",
+            overrides | {"master.algorithm": "jacobi", "master.step": "0.05 ms", "output.every": 2},
+        ),
+        "jacobi",
+    )
+    assert half.status == "completed" and half.stats.steps == 2000
+    assert half.stats.do_steps == 2 * half.stats.steps
+    assert len(half.data) == 1 + 2000 // 4 and half.signal("time")[-1] == pytest.approx(0.1)
+    # Every 4th half step is every 2nd step of 0.05 ms: the same motion, but for rounding
+    # (the grid there, the sum of the steps here).
+    assert half.data[::2] == pytest.approx(jacobi.data[::4], rel=1e-9, abs=1e-12)
+    stopped = _run(
+        tmp_path,
+        fmu_cache,
+        load_scene(
+            SCENARIOS / "two_inertias.toml",
+            {"master.algorithm": "half-jacobi", "scene.stop_when": STOP_AT_ONE_RADIAN},
+        ),
+        "stopped",
+    )
+    assert stopped.stats.extra["stopped_by_condition"]
+    assert 1.0 < stopped.signal("a.phi")[-1] < 1.0 + 10.0 * 0.5e-4
