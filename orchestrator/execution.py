@@ -21,9 +21,9 @@ from orchestrator.system import CoupledSystem
 STOP_SLACK = 1e-15
 
 
-def reached(t: float, stop: float) -> bool:
-    """The run is at its stop time (within rounding)."""
-    return t >= stop - STOP_SLACK * max(1.0, abs(stop))
+def end_time(stop: float) -> float:
+    """The instant from which a run has reached its stop time (within rounding)."""
+    return stop - STOP_SLACK * max(1.0, abs(stop))
 
 
 def condition_met(system: CoupledSystem) -> bool:
@@ -48,16 +48,17 @@ def execute(
     log = RegimeLog(system, recorder)
     counter = StepCounter(stats)
     t, stop = scene.start, scene.stop
+    end = end_time(stop)
     series.start(t)
     count = 0
-    while not reached(t, stop):
+    while t < end:
         step = master.step(t, stop)
         t = step.end
         count += 1
         logged = log.update(t if step.changes_at is None else step.changes_at, step.regimes_before)
         counter.step(step, logged)
         done = condition_met(system)
-        series.step(count, step, last=done or reached(t, stop))
+        series.step(count, step, last=done or t >= end)
         if step.failure is not None:
             raise step.failure
         try:

@@ -20,7 +20,7 @@ from orchestrator.scenario import Scene
 from orchestrator.system import CoupledSystem
 
 
-@dataclass
+@dataclass(slots=True)
 class MacroStep:
     """One accepted macro step: the system is now at ``end`` (values read and exchanged)."""
 
