@@ -8,10 +8,11 @@ interruption keeps the values at the step boundary reached.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
+from typing import Protocol
 
 from orchestrator.interrupt import Interrupted
-from orchestrator.masters import MASTERS
+from orchestrator.masters import MASTERS, MacroStep
 from orchestrator.observers import RegimeLog, StepCounter, TimeSeries
 from orchestrator.recorder import Recorder, StepStats
 from orchestrator.scenario import Scene
@@ -19,6 +20,14 @@ from orchestrator.system import CoupledSystem
 
 #: relative: a run this close to its stop time has reached it
 STOP_SLACK = 1e-15
+
+
+class Observer(Protocol):
+    """What else watches a run: told the start and every step, after the record."""
+
+    def start(self, t: float) -> None: ...
+
+    def step(self, step: MacroStep) -> None: ...
 
 
 def end_time(stop: float) -> float:
@@ -38,11 +47,13 @@ def execute(
     recorder: Recorder,
     stats: StepStats,
     progress: Callable[[float], None],
+    observers: Sequence[Observer] = (),
 ) -> None:
     """Run the scene's master over its span on an initialized ``system``.
 
     ``progress(t)`` is called after every step, between FMU calls: it may raise
-    ``Interrupted``, and the run then ends with the values at t recorded."""
+    ``Interrupted``, and the run then ends with the values at t recorded.  ``observers``
+    are told the start and every step besides the record, the regime log and the counts."""
     master = MASTERS[scene.master.algorithm](system, scene, stats)
     series = TimeSeries(system, recorder, scene.record_every)
     log = RegimeLog(system, recorder)
@@ -50,6 +61,8 @@ def execute(
     t, stop = scene.start, scene.stop
     end = end_time(stop)
     series.start(t)
+    for observer in observers:
+        observer.start(t)
     count = 0
     while t < end:
         step = master.step(t, stop)
@@ -59,6 +72,8 @@ def execute(
         counter.step(step, logged)
         done = condition_met(system)
         series.step(count, step, last=done or t >= end)
+        for observer in observers:
+            observer.step(step)
         if step.failure is not None:
             raise step.failure
         try:

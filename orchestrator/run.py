@@ -28,6 +28,7 @@ from orchestrator.errors import RunError
 from orchestrator.execution import execute
 from orchestrator.fmu_instance import file_sha256
 from orchestrator.interrupt import Interrupted, SignalGuard, catching_signals, signal_name
+from orchestrator.observers import EnergyBalance
 from orchestrator.output_lock import OutputLock
 from orchestrator.progress import ProgressBar
 from orchestrator.recorder import Recorder, StepStats
@@ -100,6 +101,7 @@ def _run_locked(
         system.close()
         raise RunError(f"cannot write results in {out}: {exc.strerror or exc}") from None
     stats = StepStats()
+    energy = EnergyBalance(system, recorder.header)
     meta = _metadata(scene, fmu_paths)
     status, message = "completed", ""
     notes: list[str] = []
@@ -127,7 +129,7 @@ def _run_locked(
         guard.check()
         system.initialize()
         guard.check()
-        execute(system, scene, recorder, stats, progress)
+        execute(system, scene, recorder, stats, progress, observers=[energy])
     except RunError as exc:
         status, message = "failed", str(exc)
         if exc.time is not None:
@@ -150,7 +152,7 @@ def _run_locked(
         # No FMU is alive any more: a signal may now stop the analyses where it lands.
         with guard.raise_at_once(), _without_numeric_warnings():
             quantities, accuracy, ref = _analyse(
-                scene, out, recorder, data, status, compare_reference, plots, notes
+                scene, out, recorder, data, energy, status, compare_reference, plots, notes
             )
     except Interrupted as exc:
         if status == "completed":
@@ -198,6 +200,7 @@ def _analyse(
     out: Path,
     recorder: Recorder,
     data: np.ndarray,
+    energy: EnergyBalance,
     status: str,
     compare_reference: bool,
     plots: bool,
@@ -211,7 +214,9 @@ def _analyse(
     with _noted(notes, "headline quantities", header):
         quantities.update(headline(scene, header, data))
     with _noted(notes, "energy residual", header):
-        residual = energy_residual(header, data)
+        # Over every step taken (the record may be thinned); a failed run's from what it
+        # recorded, the values that failed it included.
+        residual = energy.residual() if status != "failed" else energy_residual(header, data)
         if residual is not None:
             quantities["energy_residual"] = residual
     if scene.analysis and status == "completed":

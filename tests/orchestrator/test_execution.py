@@ -130,8 +130,8 @@ def test_output_every_thins_the_record_of_every_master(
     tmp_path, fmu_cache, monkeypatch, algorithm
 ) -> None:
     """Every 7th macro step and the last are recorded (a step onto a switch with its values
-    just before it); the run itself, its statistics and its events are those of the full
-    record, and each recorded row is the full record's row, bit for bit."""
+    just before it); the run itself, its statistics, its events and its energy residual are
+    those of the full record, and each recorded row is the full record's row, bit for bit."""
     spy = _Spy(execution.MASTERS[algorithm])
     monkeypatch.setitem(execution.MASTERS, algorithm, spy)
     full = _run(tmp_path, fmu_cache, _scene_for(algorithm, 1), "full")
@@ -146,6 +146,8 @@ def test_output_every_thins_the_record_of_every_master(
     for key in ("steps", "do_steps", "rejections", "rollbacks", "iterations", "events"):
         assert getattr(thinned.stats, key) == getattr(full.stats, key), key
     assert thinned.events == full.events
+    # The energy balance is kept over every step, not over the recorded ones.
+    assert thinned.headline["energy_residual"] == full.headline["energy_residual"]
     expected = [thinned.scene.start]
     for k, s in enumerate(steps, start=1):
         if k % 7 == 0 or k == len(steps):
