@@ -71,7 +71,6 @@ class StepControl:
     jump_shrinks: int = 2  # shrinks in a row that leave the change as large: a jump
     jump_ratio: float = 0.5  # "as large": the ratio fell by less than this factor
     event_time_slack: float = 1e-12  # relative: a reported event time this past the end counts
-    stop_slack: float = 1e-15  # relative: a run this close to its stop time has reached it
     settle_window: float = 10.0  # switches within this many event tolerances: one instant
     # After a switch into regimes where every accepted step so far had zero coupling error
     # (nothing the held inputs reach is exchanged, e.g. a verge in free flight), restart at

@@ -122,30 +122,3 @@ def _jsonable(value: Any) -> Any:
     if isinstance(value, Path):
         return str(value)
     return str(value)
-
-
-class RegimeLog:
-    """Logs every change of an FMU's ``regime`` output as an event (time, FMU, from, to).
-
-    A fixed-step master sees a switch only at the end of the step it happened in, so the
-    logged time is that communication point, not the switching instant.
-    """
-
-    def __init__(self, system: Any, recorder: Recorder) -> None:
-        self.system, self.recorder = system, recorder
-        # Names of the regimes, from each FMU's Enumeration type (none: the numbers).
-        self.names = [model.regime_names for model in system.models]
-        self.last = system.regimes()
-
-    def update(self, t: float) -> int:
-        now = self.system.regimes()
-        count = 0
-        for i, (a, b) in enumerate(zip(self.last, now, strict=True)):
-            if a != b:
-                names = self.names[i]
-                self.recorder.event(
-                    t, self.system.names[i], names.get(a, str(a)), names.get(b, str(b))
-                )
-                count += 1
-        self.last = now
-        return count

@@ -24,9 +24,10 @@ from fmus.build import build_fmu
 from orchestrator.accuracy import compare
 from orchestrator.analyses import energy_residual, headline, missing_column
 from orchestrator.errors import RunError
+from orchestrator.execution import execute
 from orchestrator.fmu_instance import file_sha256
 from orchestrator.interrupt import Interrupted, SignalGuard, catching_signals, signal_name
-from orchestrator.masters import MASTERS
+from orchestrator.observers import EnergyBalance
 from orchestrator.output_lock import OutputLock
 from orchestrator.progress import ProgressBar
 from orchestrator.provenance import source_commit
@@ -98,6 +99,7 @@ def _run_locked(
         system.close()
         raise RunError(f"cannot write results in {out}: {exc.strerror or exc}") from None
     stats = StepStats()
+    energy = EnergyBalance(system, recorder.header)
     meta = _metadata(scene, fmu_paths)
     status, message = "completed", ""
     notes: list[str] = []
@@ -125,18 +127,13 @@ def _run_locked(
         guard.check()
         system.initialize()
         guard.check()
-        MASTERS[scene.master.algorithm](system, scene, recorder, stats, progress)
+        execute(system, scene, recorder, stats, progress, observers=[energy])
     except RunError as exc:
         status, message = "failed", str(exc)
         if exc.time is not None:
             reached[0] = exc.time
     except Interrupted as exc:
-        status = "interrupted"
-        if recorder.rows and recorder.rows[-1][0] < reached[0]:
-            try:  # the values at the step boundary reached (a thinned record may lack it)
-                recorder.row(system.record_row(reached[0]))
-            except RunError:
-                pass
+        status = "interrupted"  # the loop kept the values at the step boundary reached
         message = (
             f"{exc}: stopped at t = {reached[0]:.9g} s (simulated); everything up to there is kept"
         )
@@ -153,7 +150,7 @@ def _run_locked(
         # No FMU is alive any more: a signal may now stop the analyses where it lands.
         with guard.raise_at_once(), _without_numeric_warnings():
             quantities, accuracy, ref = _analyse(
-                scene, out, recorder, data, status, compare_reference, plots, notes
+                scene, out, recorder, data, energy, status, compare_reference, plots, notes
             )
     except Interrupted as exc:
         if status == "completed":
@@ -201,6 +198,7 @@ def _analyse(
     out: Path,
     recorder: Recorder,
     data: np.ndarray,
+    energy: EnergyBalance,
     status: str,
     compare_reference: bool,
     plots: bool,
@@ -214,7 +212,9 @@ def _analyse(
     with _noted(notes, "headline quantities", header):
         quantities.update(headline(scene, header, data))
     with _noted(notes, "energy residual", header):
-        residual = energy_residual(header, data)
+        # Over every step taken (the record may be thinned); a failed run's from what it
+        # recorded, the values that failed it included.
+        residual = energy.residual() if status != "failed" else energy_residual(header, data)
         if residual is not None:
             quantities["energy_residual"] = residual
     if scene.analysis and status == "completed":

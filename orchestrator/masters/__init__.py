@@ -1,15 +1,20 @@
-"""Master algorithms.  Each takes (system, scene, recorder, stats, progress) and runs the
-scene with the typed settings its [master] table was read into (orchestrator.master_settings)."""
+"""Master algorithms, by the name a scene gives its ``master.algorithm``.
+
+Each entry makes the stepping algorithm of one run from (system, scene, stats); the
+algorithm reads its typed settings (orchestrator/master_settings.py) from
+``scene.master.settings``, and the execution loop (orchestrator/execution.py) steps it.
+"""
 
 from __future__ import annotations
 
 from orchestrator.master_settings import TOLERANCE_MASTERS
-from orchestrator.masters.fixed_step import run_gauss_seidel, run_jacobi
-from orchestrator.masters.regime_aware import run_regime_aware
+from orchestrator.masters.fixed_step import gauss_seidel, jacobi
+from orchestrator.masters.macro_step import MacroStep, Master, MasterFactory
+from orchestrator.masters.regime_aware import regime_aware
 
-MASTERS = {
-    "jacobi": run_jacobi,
-    "gauss-seidel": run_gauss_seidel,
-    "regime-aware": run_regime_aware,
+MASTERS: dict[str, MasterFactory] = {
+    "jacobi": jacobi,
+    "gauss-seidel": gauss_seidel,
+    "regime-aware": regime_aware,
 }
-__all__ = ["MASTERS", "TOLERANCE_MASTERS"]
+__all__ = ["MASTERS", "TOLERANCE_MASTERS", "MacroStep", "Master", "MasterFactory"]

@@ -11,7 +11,8 @@ from __future__ import annotations
 import math
 
 from orchestrator.master_settings import FixedStepSettings
-from orchestrator.recorder import Recorder, RegimeLog, StepStats
+from orchestrator.masters.macro_step import MacroStep
+from orchestrator.recorder import StepStats
 from orchestrator.scenario import Scene
 from orchestrator.system import CoupledSystem
 
@@ -21,27 +22,29 @@ def _grid(start: float, stop: float, h: float) -> int:
     return math.ceil((stop - start) / h - 1e-9)
 
 
-def run_fixed_step(
-    system: CoupledSystem,
-    h: float,
-    start: float,
-    stop: float,
-    record_every: int,
-    recorder: Recorder,
-    stats: StepStats,
-    progress,
-    sequential: bool,
-) -> None:
-    """Macro steps of h from start to stop, a row recorded every ``record_every`` steps."""
-    n = _grid(start, stop, h)
-    m = len(system.instances)
-    every = record_every
-    recorder.row(system.record_row(start))
-    log = RegimeLog(system, recorder)
-    t = start
-    for k in range(n):
-        hk = h if k < n - 1 else stop - t
-        if sequential:  # Gauss–Seidel: each FMU sees the newest outputs
+class FixedStepMaster:
+    """Macro steps of h on the grid start + k h; the last one shortened to land on stop."""
+
+    def __init__(
+        self,
+        system: CoupledSystem,
+        h: float,
+        start: float,
+        stop: float,
+        stats: StepStats,
+        sequential: bool,
+    ) -> None:
+        self.system, self.h, self.stats, self.sequential = system, h, stats, sequential
+        self.start, self.stop = start, stop
+        self.n = _grid(start, stop, h)
+        self.k = 0  # steps taken
+
+    def step(self, t: float, stop: float) -> MacroStep:
+        system, k, n = self.system, self.k, self.n
+        m = len(system.instances)
+        last = k >= n - 1
+        hk = self.stop - t if last else self.h
+        if self.sequential:  # Gauss–Seidel: each FMU sees the newest outputs
             for i in range(m):
                 system.feed(i)
                 system.step(i, t, hk)
@@ -51,55 +54,24 @@ def run_fixed_step(
                 system.feed(i)
                 system.step(i, t, hk)
             system.read_all()
-        t = start + (k + 1) * h if k < n - 1 else stop
-        stats.steps += 1
-        stats.do_steps += m
-        stats.events += log.update(t)
-        stop_indicator = system.stop_indicator()
-        done = stop_indicator is not None and stop_indicator <= 0.0
-        if (k + 1) % every == 0 or k == n - 1 or done:
-            recorder.row(system.record_row(t))
-        progress(t)
-        if done:  # a fixed-step master stops at the first step past the condition
-            stats.extra["stopped_by_condition"] = True
-            return
+        self.k += 1
+        self.stats.do_steps += m
+        # On the grid (no accumulated rounding), the last step on stop itself.
+        return MacroStep(self.stop if last else self.start + (k + 1) * self.h, hk)
 
 
-def run_fixed_step_scene(
-    system: CoupledSystem,
-    scene: Scene,
-    step: float,
-    recorder: Recorder,
-    stats: StepStats,
-    progress,
-    sequential: bool,
-) -> None:
-    """``run_fixed_step`` over the scene's span at its record interval."""
-    run_fixed_step(
-        system,
-        step,
-        scene.start,
-        scene.stop,
-        scene.record_every,
-        recorder,
-        stats,
-        progress,
-        sequential,
-    )
+def fixed_step_master(
+    system: CoupledSystem, scene: Scene, stats: StepStats, step: float, sequential: bool
+) -> FixedStepMaster:
+    """A fixed-step master of macro step ``step`` over the scene's span."""
+    return FixedStepMaster(system, step, scene.start, scene.stop, stats, sequential)
 
 
-def _run(system, scene: Scene, recorder, stats, progress, sequential: bool) -> None:
+def jacobi(system: CoupledSystem, scene: Scene, stats: StepStats) -> FixedStepMaster:
     settings: FixedStepSettings = scene.master.settings
-    run_fixed_step_scene(system, scene, settings.step, recorder, stats, progress, sequential)
+    return fixed_step_master(system, scene, stats, settings.step, sequential=False)
 
 
-def run_jacobi(
-    system: CoupledSystem, scene: Scene, recorder: Recorder, stats: StepStats, progress
-) -> None:
-    _run(system, scene, recorder, stats, progress, sequential=False)
-
-
-def run_gauss_seidel(
-    system: CoupledSystem, scene: Scene, recorder: Recorder, stats: StepStats, progress
-) -> None:
-    _run(system, scene, recorder, stats, progress, sequential=True)
+def gauss_seidel(system: CoupledSystem, scene: Scene, stats: StepStats) -> FixedStepMaster:
+    settings: FixedStepSettings = scene.master.settings
+    return fixed_step_master(system, scene, stats, settings.step, sequential=True)

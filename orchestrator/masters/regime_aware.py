@@ -35,12 +35,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, NamedTuple
 
 from orchestrator.errors import RunError
 from orchestrator.master_settings import RegimeAwareSettings
-from orchestrator.masters.fixed_step import run_fixed_step_scene
-from orchestrator.recorder import Recorder, RegimeLog, StepStats
+from orchestrator.masters.fixed_step import fixed_step_master
+from orchestrator.masters.macro_step import MacroStep, Master
+from orchestrator.observers import regime_changes
+from orchestrator.recorder import StepStats
 from orchestrator.scenario import Scene
 from orchestrator.system import CoupledSystem
 
@@ -56,21 +58,65 @@ class _Snapshot:
     stop: float | None  # the scene's stop indicator (> 0 until the condition is met)
 
 
+# What one stage of a macro step hands to the next: its trials, their corrections, the
+# switch they found and the error estimate that accepts one.
+
+
+@dataclass(frozen=True)
+class _Predictor:
+    """A predictor step over [t, t+h] with every input held at its value at t."""
+
+    t: float
+    h: float
+    states: list[Any] | None  # FMU states just after it (midpoint hold: for the corrector)
+
+
+@dataclass(frozen=True)
+class _Correction:
+    """A corrector step: held inputs averaged between the start and ``predicted``."""
+
+    predicted: list[list[float]]  # the end values it averaged toward (to retake the step)
+    ratio: float  # the correction's size relative to the tolerance
+
+
+class _Switch(NamedTuple):
+    """The earliest switch inside a trial step."""
+
+    at: float | None  # its instant, None if nothing switched
+    located: bool  # an instant an FMU reported (not an estimate from an indicator)
+
+
+class _Estimate(NamedTuple):
+    """Error estimate of a trial step relative to the tolerance (<= 1 accepts)."""
+
+    ratio: float
+    first_order: bool  # its order in h (sets how far the step shrinks or grows)
+
+
+@dataclass(frozen=True)
+class _Accepted:
+    """The trial a macro step keeps."""
+
+    h: float
+    switch_at: float | None  # the switch it ends on, if any
+    correction: _Correction | None  # its corrector step (midpoint hold)
+    left_row: list[float] | None  # values just before the switch, taken on the way
+    estimate: _Estimate | None  # its error estimate (None: not needed to accept it)
+
+
 class RegimeAwareMaster:
     def __init__(
         self,
         system: CoupledSystem,
         settings: RegimeAwareSettings,
-        start: float,
-        stop: float,
-        recorder: Recorder,
         stats: StepStats,
     ):
-        self.system, self.recorder, self.stats = system, recorder, stats
+        self.system, self.stats = system, stats
         self.cfg, self.control = settings, settings.control
-        self.start, self.stop = start, stop
         self.names = system.names
-        self.log = RegimeLog(system, recorder)
+        self.h = settings.first_step  # the step the next macro step tries first
+        self.same_instant = 0  # switches in a row within one instant (chattering guard)
+        self.last_change: tuple[str, str, str] | None = None  # (FMU, from, to), last seen
         # Exchanged Real signals held over a step: (instance, slot) of their sources.  Inputs
         # that are sampled as a state at the step start carry no hold error of their own.
         # Midpoint hold: per instance, its Real inputs in feed order as (source, averaged?);
@@ -95,7 +141,6 @@ class RegimeAwareMaster:
         self.signals = sorted(held | blind)  # start hold: every held signal's change
         self.blind = sorted(blind)
         self.scale = {s: 0.0 for s in self.signals}
-        self.first_order = not self.cfg.midpoint  # the last error ratio's order in h
         black_boxes = sorted(
             {c.target[0] for c in system.connections}
             & {n for n, model in zip(self.names, system.models, strict=True) if not model.annotated}
@@ -110,12 +155,8 @@ class RegimeAwareMaster:
         # Every Real connection source: its predictor-corrector difference is the error.
         self.outputs = sorted({s for s in system.connection_sources if s is not None})
         self.out_scale = {s: 0.0 for s in self.outputs}
-        self.ratio = 0.0  # error ratio of the last corrected trial
-        self.predicted: list[list[float]] = []  # end values the last corrected trial used
-        self.left_row: list[float] | None = None  # values just before the last landed switch
-        self.predictor_end: tuple[float, float] | None = None  # (t, h) the FMUs are at
-        self.predictor_states: list[Any] | None = None  # just after the last predictor step
-        self.located = False  # the last switch_time is an instant an FMU reported
+        #: FMU states the predictors of this macro step kept, freed at its end
+        self.kept_states: list[list[Any]] = []
         #: switches this close are one instant (chattering guard, landing on a located switch)
         self.instant = settings.control.settle_window * settings.event_tolerance
         #: per combination of regimes in which every accepted step had zero coupling error:
@@ -133,34 +174,35 @@ class RegimeAwareMaster:
             s.stop_indicator(),
         )
 
-    def trial(self, t: float, h: float) -> None:
+    def trial(self, t: float, h: float) -> _Predictor:
         """One Jacobi pass over [t, t+h] with every input held at its value at t."""
         system = self.system
         for i in range(len(system.instances)):
             system.feed(i)
-        self._step_all(t, h, keep=self.cfg.midpoint)
-        self.predictor_end = (t, h)
+        return _Predictor(t, h, self._step_all(t, h, keep=self.cfg.midpoint))
 
     def _step_all(
         self, t: float, h: float, which: list[int] | None = None, keep: bool = False
-    ) -> None:
+    ) -> list[Any] | None:
         """Step the instances (those in ``which``) over [t, t+h] and exchange; with
-        ``keep``, their states just after the step are kept for the corrector."""
+        ``keep``, their states just after the step are returned for the corrector."""
         system = self.system
         which = range(len(system.instances)) if which is None else which
         for i in which:
             system.step(i, t, h)
+        states = None
         if keep:
-            self.free_predictor_states()
-            self.predictor_states = system.get_state()
+            states = system.get_state()
+            self.kept_states.append(states)
         system.read_all()
         self.refresh()
         self.stats.do_steps += len(which)
+        return states
 
-    def free_predictor_states(self) -> None:
-        if self.predictor_states is not None:
-            self.system.free_state(self.predictor_states)
-            self.predictor_states = None
+    def free_kept_states(self) -> None:
+        for states in self.kept_states:
+            self.system.free_state(states)
+        self.kept_states.clear()
 
     def corrected_trial(
         self,
@@ -169,17 +211,18 @@ class RegimeAwareMaster:
         before: _Snapshot,
         state: list[Any],
         predicted: list[list[float]],
+        at: _Predictor | None,
         compare: list[list[float]] | None = None,
-    ) -> None:
+    ) -> _Correction:
         """Retake the step [t, t+h] from the saved state with every held input at the mean
-        of its start and ``predicted`` end values; ``self.ratio`` is the correction's size
-        (against the predictor's values at t+h, ``compare``, by default ``predicted``)
-        relative to the tolerance: the predictor's error estimate."""
+        of its start and ``predicted`` end values (``at``: the predictor step the FMUs are at
+        the end of, if any).  The correction's ratio is its size (against the predictor's
+        values at t+h, ``compare``, by default ``predicted``) relative to the tolerance:
+        the predictor's error estimate."""
         system = self.system
-        self.predicted = predicted  # to retake this very step (see _left_values)
         start = before.values
         feeds, retake = [], []
-        at_predictor = self.predictor_end == (t, h) and self.predictor_states is not None
+        at_predictor = at is not None and (at.t, at.h) == (t, h) and at.states is not None
         for i, inputs in enumerate(self.held_inputs):
             reals = [
                 0.5 * (start[s][k] + predicted[s][k]) if averaged else start[s][k]
@@ -191,11 +234,10 @@ class RegimeAwareMaster:
             if not (at_predictor and _same(reals, [start[s][k] for (s, k), _ in inputs])):
                 retake.append(i)
         # Back to the step start, those that stay to the end of their predictor step.
-        kept = self.predictor_states
+        kept = at.states if at is not None else None
         # Not read back: each is fed the values above, and read again after the step below.
         system.restore([state[i] if i in retake else kept[i] for i in range(len(feeds))])
         self.stats.rollbacks += 1
-        self.predictor_end = None
         for i in range(len(feeds)):
             system.feed(i, feeds[i], before.ints)
         self._step_all(t, h, retake)
@@ -207,7 +249,7 @@ class RegimeAwareMaster:
             scale = self.out_scale[(i, k)] = max(self.out_scale[(i, k)], abs(start[i][k]), abs(b))
             if scale > 0.0:
                 worst = max(worst, abs(b - a) / (tol * scale))
-        self.ratio = worst
+        return _Correction(predicted, worst)
 
     def refresh(self) -> None:
         """Give every FMU the others' newest outputs, so that outputs which depend on
@@ -217,7 +259,7 @@ class RegimeAwareMaster:
             system.feed(i)
         system.read_all()
 
-    def switch_time(self, t: float, h: float, before: _Snapshot) -> float | None:
+    def switch_time(self, t: float, h: float, before: _Snapshot) -> _Switch:
         """Earliest switching instant inside (t, t+h], or None if nothing switched.
 
         An FMU that reports its internal event time gives it exactly; an indicator that
@@ -252,18 +294,16 @@ class RegimeAwareMaster:
                     best = te if best is None else min(best, te)
             if fired and best is None:
                 best = t + 0.5 * h
-        self.located = best is not None and best == reported
-        return best
+        return _Switch(best, best is not None and best == reported)
 
-    def step_ratio(self, before: _Snapshot) -> float:
+    def step_ratio(self, before: _Snapshot, correction: _Correction | None) -> _Estimate:
         """Error estimate of the step just taken, relative to the tolerance (<= 1 accepts):
         the corrector's (second order), or the change of the signals held at the step start
         (first order) where that is larger."""
         if not self.cfg.midpoint:
-            return self.error_ratio(before, self.signals)
+            return _Estimate(self.error_ratio(before, self.signals), True)
         blind = self.error_ratio(before, self.blind) if self.blind else 0.0
-        self.first_order = blind > self.ratio
-        return max(self.ratio, blind)
+        return _Estimate(max(correction.ratio, blind), blind > correction.ratio)
 
     def error_ratio(self, before: _Snapshot, signals: list[tuple[int, int]]) -> float:
         """Held-input error estimate relative to the tolerance: the signals' change."""
@@ -292,59 +332,59 @@ class RegimeAwareMaster:
             f" in {self.cfg.max_iterations} rounds"
         )
 
-    def log_switches(self, t: float, before: _Snapshot) -> int:
-        self.log.last = before.regimes
-        return self.log.update(t)
+    def _note_changes(self, before: _Snapshot) -> None:
+        """Remember the last regime change since ``before`` (the chattering diagnosis)."""
+        changes = regime_changes(self.system, before.regimes, self.system.regimes())
+        if changes:
+            self.last_change = changes[-1]
 
-    # -- main loop --------------------------------------------------------------------
-    def run(self, progress) -> None:
-        cfg, system, stats, recorder = self.cfg, self.system, self.stats, self.recorder
+    # -- one macro step (the execution loop calls it) ---------------------------------
+    def step(self, t: float, stop: float) -> MacroStep:
+        """One accepted macro step from t: onto the first switch inside it (then the
+        exchange there is settled), or as long as the error test allows."""
+        cfg, system, stats = self.cfg, self.system, self.stats
         control = self.control
-        t, stop = self.start, self.stop
-        h = cfg.first_step
-        recorder.row(system.record_row(t))
-        same_instant = 0
-        while t < stop - control.stop_slack * max(1.0, abs(stop)):
-            h = min(h, stop - t)
-            state = system.get_state()
-            before = self.snapshot()  # consistent: every trial and settle ends refreshed
-            try:
-                h, te = self._attempt(t, h, before, state)
-                if te is not None:
-                    left = self._left_values(t, te, h, state, before)
-            finally:
-                system.free_state(state)
-                self.free_predictor_states()
-            t += h
-            stats.steps += 1
-            if te is None:
-                ratio = self.step_ratio(before)
-                stats.events += self.log_switches(t - h, before)  # switched at the start
-                recorder.row(system.record_row(t))
-                h = min(cfg.max_step, h * control.grow(ratio, self.first_order))
-                self._remember_step(tuple(before.regimes), ratio, h)
-                same_instant = 0
-            else:
-                if left is not None:
-                    recorder.row(left)  # values just before the switch
-                stats.iterations += self.settle() - 1
-                stats.events += max(self.log_switches(t, before), 1)
-                recorder.row(system.record_row(t))  # values just after the switch
-                window = self.instant
-                same_instant = same_instant + 1 if h <= window else 0
-                if same_instant > cfg.max_events_per_step:
-                    raise RunError(
-                        f"chattering: {same_instant} switches within "
-                        f"{window:.1e} s of each other; "
-                        f"last in {self._last_switch()}",
-                        t,
-                    )
-                h = self._restart_step(tuple(system.regimes()))
-            progress(t)
-            stop_indicator = system.stop_indicator()
-            if stop_indicator is not None and stop_indicator <= 0.0:
-                stats.extra["stopped_by_condition"] = True
-                return
+        h = min(self.h, stop - t)
+        state = system.get_state()
+        before = self.snapshot()  # consistent: every trial and settle ends refreshed
+        try:
+            accepted = self._attempt(t, h, before, state)
+            h, te = accepted.h, accepted.switch_at
+            if te is not None:
+                left = self._left_values(t, accepted, state, before)
+        finally:
+            system.free_state(state)
+            self.free_kept_states()
+        end = t + h
+        if te is None:
+            ratio, first_order = accepted.estimate
+            self._note_changes(before)
+            self.h = min(cfg.max_step, h * control.grow(ratio, first_order))
+            self._remember_step(tuple(before.regimes), ratio, self.h)
+            self.same_instant = 0
+            # A regime that changed without a located switch changed at the step start.
+            return MacroStep(end, h, changes_at=t, regimes_before=before.regimes)
+        stats.iterations += self.settle() - 1
+        self._note_changes(before)
+        failure = None
+        window = self.instant
+        self.same_instant = self.same_instant + 1 if h <= window else 0
+        if self.same_instant > cfg.max_events_per_step:
+            failure = RunError(
+                f"chattering: {self.same_instant} switches within "
+                f"{window:.1e} s of each other; "
+                f"last in {self._last_switch()}",
+                end,
+            )
+        self.h = self._restart_step(tuple(system.regimes()))
+        return MacroStep(
+            end,
+            h,
+            switched=True,
+            regimes_before=before.regimes,
+            left_row=left,  # values just before the switch
+            failure=failure,
+        )
 
     def _remember_step(self, regimes: tuple[int | None, ...], ratio: float, h: float) -> None:
         """Keep the step proposed after an accepted one in ``regimes`` while no step there
@@ -360,8 +400,8 @@ class RegimeAwareMaster:
         remembered = self.zero_error_step.get(regimes, 0.0) * self.control.zero_error_restart
         return max(self.cfg.first_step, remembered)  # remembered steps are <= max_step
 
-    def _attempt(self, t: float, h: float, before: _Snapshot, state: list[Any]):
-        """Trial steps from t until one is accepted; returns (h, switch time or None).
+    def _attempt(self, t: float, h: float, before: _Snapshot, state: list[Any]) -> _Accepted:
+        """Trial steps from t until one is accepted.
 
         A signal that jumps without a reported event (its change does not shrink with the
         step) is a discontinuity: the step that contains it is accepted as a switch.
@@ -370,32 +410,39 @@ class RegimeAwareMaster:
         last_ratio = None
         stalled = 0
         for _ in range(control.max_trials):
-            self.left_row = None  # set by _correct_landing for this very trial
-            self.trial(t, h)
-            te = self.switch_time(t, h, before)
+            left_row, correction = None, None  # _correct_landing may take both
+            predictor = self.trial(t, h)
+            te, located = self.switch_time(t, h, before)
             if te is not None and cfg.midpoint:
-                te = self._correct_landing(t, h, te, before, state)
+                te, located, left_row, correction = self._correct_landing(
+                    t, h, te, located, before, state, predictor
+                )
             elif cfg.midpoint:
-                self.corrected_trial(t, h, before, state, [list(v) for v in self.system.values])
-                te = self.switch_time(t, h, before)
+                correction = self.corrected_trial(
+                    t, h, before, state, [list(v) for v in self.system.values], predictor
+                )
+                te, located = self.switch_time(t, h, before)
             if te is not None:
-                if t + h - te <= self._landing_window() or h <= cfg.min_step:
-                    ratio = self.step_ratio(before) if cfg.midpoint else 0.0
+                if t + h - te <= self._landing_window(located) or h <= cfg.min_step:
+                    estimate = self.step_ratio(before, correction) if cfg.midpoint else None
+                    ratio = estimate.ratio if estimate is not None else 0.0
                     if ratio > 1.0 and h > cfg.min_step:
                         # The step onto the switch must pass the error test as well:
                         # approach it in shorter steps (the held-input error at an impact
                         # is the speed mismatch of the two sides, hence the energy).
-                        h = max(cfg.min_step, h * control.shrink(ratio, self.first_order))
+                        h = max(cfg.min_step, h * control.shrink(ratio, estimate.first_order))
                         self._rollback(state, before)
                         last_ratio = None
                         continue
-                    return h, te  # the step ends on the switch
+                    # The step ends on the switch.
+                    return _Accepted(h, te, correction, left_row, estimate)
                 # End the retaken step just past the located instant.
                 h = max(te - t + 0.5 * cfg.event_tolerance, cfg.min_step)
                 self._rollback(state, before)
                 last_ratio = None
                 continue
-            ratio = self.step_ratio(before)
+            estimate = self.step_ratio(before, correction)
+            ratio = estimate.ratio
             if ratio > 1.0 and h > cfg.min_step:
                 # Two shrinks in a row that leave the change as large: a jump, not a smooth
                 # change (one shrink is not proof: a long step may span an oscillation).
@@ -403,70 +450,80 @@ class RegimeAwareMaster:
                 stalled = stalled + 1 if as_large else 0
                 if stalled >= control.jump_shrinks:
                     self.stats.extra["jumps"] = self.stats.extra.get("jumps", 0) + 1
-                    return h, t + h  # land after the jump and treat it as a switch
+                    # Land after the jump and treat it as a switch.
+                    return _Accepted(h, t + h, correction, left_row, estimate)
                 last_ratio = ratio
-                h = max(cfg.min_step, h * control.shrink(ratio, self.first_order))
+                h = max(cfg.min_step, h * control.shrink(ratio, estimate.first_order))
                 self._rollback(state, before)
                 continue
-            return h, None
+            return _Accepted(h, None, correction, left_row, estimate)
         raise RunError(
             f"no acceptable step from here after {control.max_trials} trials (last h = {h:.3e} s)",
             t,
         )
 
     def _correct_landing(
-        self, t: float, h: float, te: float, before: _Snapshot, state: list[Any]
-    ) -> float | None:
+        self,
+        t: float,
+        h: float,
+        te: float,
+        located: bool,
+        before: _Snapshot,
+        state: list[Any],
+        predictor: _Predictor,
+    ) -> tuple[float | None, bool, list[float] | None, _Correction | None]:
         """The predictor saw a switch at te inside [t, t+h]: if the step does not yet end on
         it, the caller shortens it (te is returned as is).  If it does, the step is corrected
         with the end values predicted just before the switch (those after it would average a
-        jump into the held inputs), and the corrected step's own switch time is returned
-        (None if the correction moved the switch past the step end)."""
+        jump into the held inputs), and the corrected step's own switch is returned (None if
+        the correction moved it past the step end), with the values recorded just before the
+        switch and the correction."""
         cfg = self.cfg
-        if t + h - te > self._landing_window() and h > cfg.min_step:
-            return te
+        if t + h - te > self._landing_window(located) and h > cfg.min_step:
+            return te, located, None, None
         crossed = [list(v) for v in self.system.values]  # the predictor across the switch
         h_left = te - t - 0.5 * cfg.event_tolerance
         if h_left > 0.0:
             self._restore(state, before)
-            self.trial(t, h_left)
+            predictor = self.trial(t, h_left)
             predicted = [list(v) for v in self.system.values]
             # Kept as the recorded values just before the switch: the accepted step's error
             # test bounds this predictor's error by the tolerance, and retaking the step
             # only to record them cost four trials per switch.
-            self.left_row = self.system.record_row(t + h_left)
+            left_row = self.system.record_row(t + h_left)
         else:
             predicted = before.values
-            self.left_row = None
-        self.corrected_trial(t, h, before, state, predicted, compare=crossed)
-        return self.switch_time(t, h, before)
+            left_row = None
+        correction = self.corrected_trial(t, h, before, state, predicted, predictor, crossed)
+        return *self.switch_time(t, h, before), left_row, correction
 
-    def _landing_window(self) -> float:
+    def _landing_window(self, located: bool) -> float:
         """How far before the step end a switch may be for the step to end on it: the
         event tolerance, or for an instant an FMU located, one instant (retaking a step
         moves the located instant by the retake's own rounding and held inputs, by a few
         event tolerances; chasing that cost three trials a time for nothing measurable)."""
-        return self.instant if self.located else self.cfg.event_tolerance
+        return self.instant if located else self.cfg.event_tolerance
 
     def _left_values(
-        self, t: float, te: float, h: float, state: list[Any], before: _Snapshot
+        self, t: float, accepted: _Accepted, state: list[Any], before: _Snapshot
     ) -> list[float] | None:
-        """Recorded values just before the switch at te (then the step is retaken to t+h)."""
+        """Recorded values just before the switch the accepted step ends on (then the step
+        is retaken to its end)."""
+        te, h = accepted.switch_at, accepted.h
         h_left = te - t - 0.5 * self.cfg.event_tolerance
         if h_left <= 0.0:
             return None
-        if self.cfg.midpoint and self.left_row is not None:
-            return self.left_row  # taken on the way to this step (_correct_landing)
-        accepted = self.predicted
+        if self.cfg.midpoint and accepted.left_row is not None:
+            return accepted.left_row  # taken on the way to this step (_correct_landing)
         self._rollback(state, before)
-        self.trial(t, h_left)
+        predictor = self.trial(t, h_left)
         if self.cfg.midpoint:
             predicted = [list(v) for v in self.system.values]
-            self.corrected_trial(t, h_left, before, state, predicted)
+            self.corrected_trial(t, h_left, before, state, predicted, predictor)
         row = self.system.record_row(t + h_left)
         if self.cfg.midpoint:
             # The very inputs of the accepted step: the retake must cross the switch again.
-            self.corrected_trial(t, h, before, state, accepted)
+            self.corrected_trial(t, h, before, state, accepted.correction.predicted, None)
         else:
             self._rollback(state, before)
             self.trial(t, h)
@@ -477,7 +534,6 @@ class RegimeAwareMaster:
         the values there are those read then."""
         self.system.set_state(state, (before.values, before.ints))
         self.stats.rollbacks += 1
-        self.predictor_end = None
 
     def _rollback(self, state: list[Any], before: _Snapshot) -> None:
         """Back to the step start after a rejected trial."""
@@ -485,9 +541,9 @@ class RegimeAwareMaster:
         self.stats.rejections += 1
 
     def _last_switch(self) -> str:
-        if not self.recorder.events:
+        if self.last_change is None:
             return "no FMU"
-        t, sub, a, b = self.recorder.events[-1]
+        sub, a, b = self.last_change
         return f"FMU {sub!r} ({a} -> {b})"
 
 
@@ -498,9 +554,9 @@ def _same(a: list[float], b: list[float]) -> bool:
     )
 
 
-def run_regime_aware(
-    system: CoupledSystem, scene: Scene, recorder: Recorder, stats: StepStats, progress
-) -> None:
+def regime_aware(system: CoupledSystem, scene: Scene, stats: StepStats) -> Master:
+    """The regime-aware master of ``scene``; fixed-step Jacobi where an FMU cannot save and
+    restore its state."""
     blind = [n for n, m in zip(system.names, system.models, strict=True) if not m.can_get_set_state]
     if blind:
         # Without rollback no trial can be taken back: say what is given up, and couple
@@ -512,11 +568,5 @@ def run_regime_aware(
             f"master.step = {scene.master.step:g} s (no error control, switches seen only "
             "at communication points)"
         )
-        run_fixed_step_scene(
-            system, scene, scene.master.step, recorder, stats, progress, sequential=False
-        )
-        return
-    master = RegimeAwareMaster(
-        system, scene.master.settings, scene.start, scene.stop, recorder, stats
-    )
-    master.run(progress)
+        return fixed_step_master(system, scene, stats, scene.master.step, sequential=False)
+    return RegimeAwareMaster(system, scene.master.settings, stats)
