@@ -282,6 +282,9 @@ def _release_runtime(library: str) -> None:
         return
     try:
         runtime = ctypes.CDLL(library, mode=os.RTLD_NOLOAD | os.RTLD_NOW)
-    except OSError:
-        return  # unloaded already, its destructors run in order
-    runtime.finalizePythonInterpreter()
+        release = runtime.finalizePythonInterpreter
+    except (OSError, AttributeError):
+        # unloaded already, its destructors run in order; or the FMU's loader, which
+        # releases the runtime beside it by itself
+        return
+    release()
