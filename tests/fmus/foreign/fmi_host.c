@@ -6,15 +6,16 @@
  * with mechcosim on the same FMUs.
  *
  * Job file, one directive per line:
- *   sequence <start> <step> <steps>   every FMU below in turn: the full call sequence
+ *   sequence <start> <steps>          every FMU below in turn: the full call sequence
  *   jacobi <start> <stop> <step> <steps>   the FMUs below coupled, fixed-step Jacobi
  *   fmu <instance> <unzipped dir> <model identifier> <guid>
+ *   step <size>                       the communication step of the sequence (last fmu)
  *   set <r|i|b> <vr> <value>          a start value, set in initialization mode (last fmu)
  *   out <r|i> <vr>                    an output printed after each step (last fmu)
  *   connect <r|i> <from instance> <vr> <to instance> <vr>
  *
- * Output lines: "<label> <t> <values...>"; the logger prints "log <status> <instance>:
- * <message>".  The exit code is 0 when every call returned what it should.
+ * Output lines: "<instance>:<label> <t> <values...>" (sequence) or "<instance> <t>
+ * <values...>" (jacobi); the logger prints "log <status> <instance>: <message>".  The exit code is 0 when every call returned what it should.
  */
 #define _GNU_SOURCE
 #include <dlfcn.h>
@@ -45,6 +46,7 @@ typedef struct {
     int n_sets;
     Var outs[MAX_VARS];
     int n_outs;
+    double h;
     fmi2Component c;
     fmi2InstantiateTYPE* instantiate;
     fmi2FreeInstanceTYPE* free_instance;
@@ -176,7 +178,10 @@ static void initialize(Fmu* f, fmi2Component c, double start) {
 }
 
 static void print_outputs(Fmu* f, fmi2Component c, const char* label, double t) {
-    printf("%s %.17g", label, t);
+    if (label[0])
+        printf("%s:%s %.17g", f->name, label, t);
+    else
+        printf("%s %.17g", f->name, t);
     for (int k = 0; k < f->n_outs; ++k) {
         Var* v = &f->outs[k];
         if (v->type == 'r') {
@@ -201,7 +206,8 @@ static void steps(Fmu* f, fmi2Component c, const char* label, double start, doub
 }
 
 /* The full call sequence on one FMU; every labelled run must print what "run" printed. */
-static void sequence(Fmu* f, double start, double h, int n) {
+static void sequence(Fmu* f, double start, int n) {
+    double h = f->h;
     char name[128];
     snprintf(name, sizeof name, "%s_a", f->name);
     fmi2Component a = instantiate(f, name);
@@ -224,7 +230,7 @@ static void sequence(Fmu* f, double start, double h, int n) {
     steps(f, a, "restored", start, h, half, n);
     CHECK(f->free_state(a, &state), "fmi2FreeFMUstate", f->id);
     /* a step of zero size is refused, and the host hears why at default logging */
-    printf("zero step status %d\n", f->do_step(a, start + n * h, 0.0, fmi2True));
+    printf("%s:zero step status %d\n", f->name, f->do_step(a, start + n * h, 0.0, fmi2True));
     CHECK(f->reset(a), "fmi2Reset", f->id);
     initialize(f, a, start);
     steps(f, a, "reset", start, h, 0, n);
@@ -309,7 +315,7 @@ static void jacobi(double start, double stop, double h, int n) {
             CHECK(fmus[j].do_step(fmus[j].c, t, h, fmi2True), "fmi2DoStep", fmus[j].id);
         }
         READ_SOURCES();
-        for (int j = 0; j < n_fmus; ++j) print_outputs(&fmus[j], fmus[j].c, fmus[j].name, start + (k + 1) * h);
+        for (int j = 0; j < n_fmus; ++j) print_outputs(&fmus[j], fmus[j].c, "", start + (k + 1) * h);
     }
     for (int j = 0; j < n_fmus; ++j) {
         CHECK(fmus[j].terminate(fmus[j].c), "fmi2Terminate", fmus[j].id);
@@ -343,13 +349,15 @@ int main(int argc, char** argv) {
         if (sscanf(line, "%31s", word) != 1) continue;
         if (strcmp(word, "sequence") == 0) {
             snprintf(mode, sizeof mode, "%s", word);
-            sscanf(line, "%*s %lf %lf %d", &start, &h, &n);
+            sscanf(line, "%*s %lf %d", &start, &n);
         } else if (strcmp(word, "jacobi") == 0) {
             snprintf(mode, sizeof mode, "%s", word);
             sscanf(line, "%*s %lf %lf %lf %d", &start, &stop, &h, &n);
         } else if (strcmp(word, "fmu") == 0) {
             Fmu* f = &fmus[n_fmus++];
             sscanf(line, "%*s %63s %4095s %255s %127s", f->name, f->dir, f->id, f->guid);
+        } else if (strcmp(word, "step") == 0) {
+            sscanf(line, "%*s %lf", &fmus[n_fmus - 1].h);
         } else if (strcmp(word, "set") == 0 || strcmp(word, "out") == 0) {
             Fmu* f = &fmus[n_fmus - 1];
             Var* v = word[0] == 's' ? &f->sets[f->n_sets++] : &f->outs[f->n_outs++];
@@ -365,7 +373,7 @@ int main(int argc, char** argv) {
     fclose(job);
     for (int j = 0; j < n_fmus; ++j) load(&fmus[j]);
     if (strcmp(mode, "sequence") == 0) {
-        for (int j = 0; j < n_fmus; ++j) sequence(&fmus[j], start, h, n);
+        for (int j = 0; j < n_fmus; ++j) sequence(&fmus[j], start, n);
     } else if (strcmp(mode, "jacobi") == 0) {
         jacobi(start, stop, h, n);
     }
