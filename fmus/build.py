@@ -35,7 +35,7 @@ from pythonfmu.builder import FmuBuilder
 from components.base import Component
 from fmus.description import complete_description
 from fmus.documentation import render_documentation
-from fmus.host_loader import LOADER_SOURCE, loader_plan, pack_loader
+from fmus.host_loader import LOADER_SOURCE, loader_binary, loader_plan, pack_loader
 from fmus.registry import FMU_WRAPPERS, FmuWrapper
 
 FMUS_DIR = Path(__file__).resolve().parent
@@ -193,7 +193,10 @@ def _build(wrapper: FmuWrapper, digest: str, tmp: Path) -> Path:
     docs = tmp / "documentation"
     docs.mkdir()
     component_class = wrapper.component_class()
-    (docs / "index.html").write_text(render_documentation(wrapper, component_class, needs))
+    loader = loader_binary(wrapper.name)
+    (docs / "index.html").write_text(
+        render_documentation(wrapper, component_class, needs, loader=loader is not None)
+    )
     modules_before = set(sys.modules)
     try:
         built = FmuBuilder.build_FMU(
@@ -210,11 +213,13 @@ def _build(wrapper: FmuWrapper, digest: str, tmp: Path) -> Path:
                 del sys.modules[module]
         while str(stage) in sys.path:
             sys.path.remove(str(stage))
-    _finish(Path(built), component_class, wrapper.name, digest)
+    _finish(Path(built), component_class, wrapper.name, digest, loader)
     return Path(built)
 
 
-def _finish(fmu: Path, component_class: type[Component], name: str, digest: str) -> None:
+def _finish(
+    fmu: Path, component_class: type[Component], name: str, digest: str, loader: bytes | None
+) -> None:
     """Complete the model description, put the loader in, and write the archive anew."""
     with zipfile.ZipFile(fmu) as z:
         members = {n: z.read(n) for n in z.namelist()}
@@ -228,7 +233,8 @@ def _finish(fmu: Path, component_class: type[Component], name: str, digest: str)
     complete_description(root, component_class)
     xml = parseString(ET.tostring(root, "UTF-8")).toprettyxml(indent="  ", encoding="UTF-8")
     members["modelDescription.xml"] = xml
-    pack_loader(members, name, name)
+    if loader is not None:
+        pack_loader(members, name, loader)
     with zipfile.ZipFile(fmu, "w", zipfile.ZIP_DEFLATED) as z:
         for n in sorted(members):
             info = zipfile.ZipInfo(n, ZIP_DATE)

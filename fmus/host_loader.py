@@ -151,29 +151,27 @@ def compiled_loader(compiler: str, identity: str) -> bytes:
         return (Path(tmp) / "loader.so").read_bytes()
 
 
-def pack_loader(members: dict[str, bytes], model_identifier: str, name: str) -> None:
-    """Put the loader in place of pythonfmu's runtime in the FMU's ``members`` (the runtime
-    moves beside it), with resources/python.txt; or, where the loader cannot be built, say
-    so in one line and leave the runtime alone."""
-    binary = f"binaries/{PLATFORM}/{model_identifier}.so"
-    if binary not in members:
-        return
+def loader_binary(name: str) -> bytes | None:
+    """The loader's binary for FMU ``name``; None (said in one line) where this environment
+    cannot build it, and the FMU keeps pythonfmu's runtime alone."""
     plan = loader_plan()
-    if not plan.packs_loader:
-        say_once(
-            f"{name}: {plan.why_not}: the FMU's Linux binary is pythonfmu's runtime alone, "
-            "which loads in hosts that run Python only"
-        )
-        return
-    try:
-        loader = compiled_loader(plan.compiler, plan.identity)
-    except RuntimeError as exc:
-        last = str(exc).strip().splitlines()[-1]
-        say_once(
-            f"{name}: compiling the loader failed ({last}): the FMU's Linux binary is "
-            "pythonfmu's runtime alone, which loads in hosts that run Python only"
-        )
-        return
+    why_not = plan.why_not
+    if plan.packs_loader:
+        try:
+            return compiled_loader(plan.compiler, plan.identity)
+        except RuntimeError as exc:
+            why_not = f"compiling the loader failed ({str(exc).strip().splitlines()[-1]})"
+    say_once(
+        f"{name}: {why_not}: the FMU's Linux binary is pythonfmu's runtime alone, which "
+        "loads in hosts that run Python only"
+    )
+    return None
+
+
+def pack_loader(members: dict[str, bytes], model_identifier: str, loader: bytes) -> None:
+    """Put ``loader`` in place of pythonfmu's runtime in the FMU's ``members`` (the runtime
+    moves beside it), with resources/python.txt."""
+    binary = f"binaries/{PLATFORM}/{model_identifier}.so"
     members[f"binaries/{PLATFORM}/{RUNTIME_FILE}"] = members[binary]
     members[binary] = loader
-    members[PYTHON_FILE] = plan.python_record.encode()
+    members[PYTHON_FILE] = loader_plan().python_record.encode()
