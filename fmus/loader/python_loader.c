@@ -554,6 +554,19 @@ EXPORT fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, 
     i->relayed.logger = relay;
     i->relayed.componentEnvironment = i;
     i->debug = loggingOn;
+    /* The runtime cannot do without the resource location: where a host gives none, the
+     * FMU's own resources/ beside binaries/ is meant. */
+    char resources[PATH_MAX + 32];
+    if (fmuResourceLocation == NULL || fmuResourceLocation[0] == '\0') {
+        char binaries[PATH_MAX];
+        if (!own_directory(binaries, sizeof binaries, why)) {
+            emit(functions, name, fmi2Error, "logStatusError", why);
+            free_instance(i);
+            return NULL;
+        }
+        snprintf(resources, sizeof resources, "file://%s/../../resources", binaries);
+        fmuResourceLocation = resources;
+    }
     /* The runtime logs with debug logging on, always: relay() does the filtering. */
     i->inner = runtime.fmi2Instantiate(instanceName, fmuType, fmuGUID, fmuResourceLocation,
                                        &i->relayed, visible, 1);

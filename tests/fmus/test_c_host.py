@@ -142,7 +142,7 @@ def test_the_full_call_sequence_in_a_c_host_matches_fmpy(host: Path, tmp_path: P
     """GearTrain, VergeEscapement and DetachedLever (which needs numpy), one after the other
     in one C process: instantiate, set up, initialize with Real and Integer start values,
     step, get/set/free the FMU state, a refused step, reset, terminate, free, instantiate
-    again, two instances side by side."""
+    again, two instances side by side, an instance that failed fatally."""
     job = [f"sequence 0 {STEPS}"]
     expected = {}
     for name, values in ALONE.items():
@@ -166,6 +166,11 @@ def test_the_full_call_sequence_in_a_c_host_matches_fmpy(host: Path, tmp_path: P
         # the refused step says why, although the host left debug logging off
         assert f"{name}:zero step status 2" in out, name
         assert any(ln.startswith(f"log Error {name}_a:") and "refused" in ln for ln in out), name
+        # fmi2Fatal, then fmi2Error for a call on the failed instance; both said why
+        assert f"{name}:after an unknown value reference 4, then 3" in out, name
+        said = [ln for ln in out if ln.startswith("log ") and f" {name}_d:" in ln]
+        assert said[0].startswith(f"log Fatal {name}_d:") and "index out of range" in said[0], said
+        assert "fmi2DoStep: the instance failed fatally before" in said[-1], said
 
 
 def test_m739_train_and_verge_coupled_in_a_c_host_match_our_jacobi_master(

@@ -256,6 +256,24 @@ static void sequence(Fmu* f, double start, int n) {
     CHECK(f->terminate(c), "fmi2Terminate", f->id);
     f->free_instance(b);
     f->free_instance(c);
+
+    /* An unknown value reference: the runtime answers fmi2Fatal, the instance refuses every
+     * later call with fmi2Error, and freeing it does not crash.  No resource location: the
+     * FMU finds its own. */
+    snprintf(name, sizeof name, "%s_d", f->name);
+    fmi2Component d =
+        f->instantiate(name, fmi2CoSimulation, f->guid, NULL, &callbacks, fmi2False, fmi2False);
+    if (d == NULL) {
+        fail("fmi2Instantiate without a resource location", f->id);
+        return;
+    }
+    initialize(f, d, start);
+    fmi2ValueReference unknown = 999999;
+    fmi2Real x = 0;
+    fmi2Status first = f->get_real(d, &unknown, 1, &x);
+    fmi2Status then = f->do_step(d, start, h, fmi2True);
+    printf("%s:after an unknown value reference %d, then %d\n", f->name, first, then);
+    f->free_instance(d);
 }
 
 /* Fixed-step Jacobi: every FMU steps with the outputs of the last communication point. */
