@@ -10,6 +10,7 @@ master (the M739 train and verge coupled), value for value.
 from __future__ import annotations
 
 import math
+import shutil
 import subprocess
 import sys
 import venv
@@ -277,3 +278,25 @@ def test_without_a_c_compiler_the_build_says_so_and_the_fmu_runs_in_python_hosts
     assert host_loader.RUNTIME_FILE not in " ".join(names) and host_loader.PYTHON_FILE not in names
     assert path != build_fmu("Inertia", tmp_path)  # with the compiler: another build
     assert len(simulate_fmu(str(path), stop_time=0.01, output_interval=1e-3)) == 11
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(shutil.which("valgrind") is None, reason="needs valgrind")
+def test_the_c_host_exits_without_touching_freed_memory(host: Path, tmp_path: Path) -> None:
+    """pythonfmu's runtime resets freed interpreter state from its library destructor when a
+    process exits with it loaded; the loader releases that state first (without it valgrind
+    sees invalid reads at exit in this very run)."""
+    path = build_fmu("GearTrain")
+    job = ["sequence 0 2", *fmu_lines("train", path, unpack(path, tmp_path / "x"), {}, [])]
+    job.append("step 1e-5")
+    (tmp_path / "job.txt").write_text("\n".join(job) + "\n")
+    run = subprocess.run(
+        ["valgrind", "--error-exitcode=99", str(host), str(tmp_path / "job.txt")],
+        env={},
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    assert run.returncode == 0, run.stderr[-3000:]
+    assert run.stdout.splitlines()[-1] == "done 0 failures"
+    assert "ERROR SUMMARY: 0 errors" in run.stderr
