@@ -88,13 +88,13 @@ def outputs(path: Path) -> list:
     return [v for v in md.modelVariables if v.causality == "output" and v.type != "Boolean"]
 
 
-def fmpy_run(path: Path, values: dict, outs: list, step: float) -> np.ndarray:
+def fmpy_run(path: Path, values: dict, outs: list, step: float, scratch: Path) -> np.ndarray:
     """The C host's "run" lines, by FMPy (a Python host) on the same FMU."""
     md = read_model_description(str(path))
     variables = {v.name: v for v in md.modelVariables}
     fmu = FMU2Slave(
         guid=md.guid,
-        unzipDirectory=str(unpack(path, path.parent / f"{path.stem}-fmpy")),
+        unzipDirectory=str(unpack(path, scratch)),
         modelIdentifier=md.coSimulation.modelIdentifier,
         instanceName="fmpy",
     )
@@ -150,7 +150,7 @@ def test_the_full_call_sequence_in_a_c_host_matches_fmpy(host: Path, tmp_path: P
         path = build_fmu(name)
         outs = outputs(path)
         step = float(read_model_description(str(path)).defaultExperiment.stepSize)
-        expected[name] = fmpy_run(path, values, outs, step)
+        expected[name] = fmpy_run(path, values, outs, step, tmp_path / f"{name}-fmpy")
         job += fmu_lines(name, path, unpack(path, tmp_path / name), values, outs)
         job.append(f"step {step!r}")
     (tmp_path / "job.txt").write_text("\n".join(job) + "\n")
