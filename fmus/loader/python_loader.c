@@ -378,8 +378,9 @@ static int choose_python(const char* binaries, PythonChoice* choice, char* why) 
         }                                                                                       \
     } while (0)
 
+/* What starting Python takes (a Python host's interpreter is used as it is: only
+ * Py_IsInitialized is asked of it). */
 static int python_functions(void* handle, char* why) {
-    PY_FUNCTION(handle, Py_IsInitialized);
     PY_FUNCTION(handle, Py_GetVersion);
     PY_FUNCTION(handle, PyConfig_InitPythonConfig);
     PY_FUNCTION(handle, PyConfig_SetBytesString);
@@ -457,8 +458,9 @@ static int python_ready(const char* binaries, char* why) {
             return 0;
         }
     }
-    if (!python_functions(handle, why)) return 0;
+    PY_FUNCTION(handle, Py_IsInitialized);
     if (py.Py_IsInitialized()) return 1; /* a Python host: its interpreter, as it is */
+    if (!python_functions(handle, why)) return 0;
     if (!chosen && !choose_python(binaries, &choice, why)) return 0;
     return start_python(&choice, why);
 }
