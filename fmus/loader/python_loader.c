@@ -289,46 +289,78 @@ static void trim(char* s) {
     while (n > 0 && (s[n - 1] == '\n' || s[n - 1] == '\r' || s[n - 1] == ' ')) s[--n] = '\0';
 }
 
-/* A library beside an executable: <base prefix>/lib/<soname> (the base prefix of a virtual
- * environment is the directory pyvenv.cfg's "home" names, less its bin/), else the soname on
- * the system's library path. */
-static void library_beside(const char* executable, char* library) {
-    char soname[64];
-    snprintf(soname, sizeof soname, "libpython%d.%d.so.1.0", PY_MAJOR_VERSION, PY_MINOR_VERSION);
-    char bin[PATH_MAX];
-    snprintf(bin, sizeof bin, "%s", executable);
-    char* slash = strrchr(bin, '/');
+/* What can be told of a Python executable without running it: the directory of its base
+ * installation's executable (a virtual environment's pyvenv.cfg names it as "home") and its
+ * version (pyvenv.cfg's "version", else the name python3.X the executable resolves to;
+ * 0.0 when neither says). */
+static void inspect_executable(const char* executable, char* base_bin, int* major, int* minor) {
+    *major = *minor = 0;
+    char dir[PATH_MAX];
+    snprintf(dir, sizeof dir, "%s", executable);
+    char* slash = strrchr(dir, '/');
     if (slash) *slash = '\0';
+    char real[PATH_MAX] = "";
+    if (realpath(executable, real)) {
+        const char* name = strrchr(real, '/') ? strrchr(real, '/') + 1 : real;
+        sscanf(name, "python%d.%d", major, minor);
+        slash = strrchr(real, '/');
+        if (slash) *slash = '\0';
+        snprintf(base_bin, PATH_MAX, "%s", real);
+    } else {
+        snprintf(base_bin, PATH_MAX, "%s", dir);
+    }
     char cfg_path[PATH_MAX + 16];
-    snprintf(cfg_path, sizeof cfg_path, "%s/../pyvenv.cfg", bin);
+    snprintf(cfg_path, sizeof cfg_path, "%s/../pyvenv.cfg", dir);
     FILE* cfg = fopen(cfg_path, "r");
-    if (cfg) {
-        char line[PATH_MAX + 32];
-        while (fgets(line, sizeof line, cfg)) {
-            char* value = strchr(line, '=');
-            if (strncmp(line, "home", 4) == 0 && value) {
-                value++;
-                while (*value == ' ') value++;
-                trim(value);
-                snprintf(bin, sizeof bin, "%s", value);
-            }
-        }
-        fclose(cfg);
-    } else {
-        char real[PATH_MAX];
-        if (realpath(executable, real)) {
-            slash = strrchr(real, '/');
-            if (slash) *slash = '\0';
-            snprintf(bin, sizeof bin, "%s", real);
-        }
+    if (cfg == NULL) return;
+    char line[PATH_MAX + 32];
+    while (fgets(line, sizeof line, cfg)) {
+        char* value = strchr(line, '=');
+        if (value == NULL) continue;
+        value++;
+        while (*value == ' ') value++;
+        trim(value);
+        if (strncmp(line, "home", 4) == 0)
+            snprintf(base_bin, PATH_MAX, "%s", value);
+        else if (strncmp(line, "version", 7) == 0)
+            sscanf(value, "%d.%d", major, minor);
     }
+    fclose(cfg);
+}
+
+/* The shared libpython of an executable: <base installation>/lib/libpython3.X.so.1.0, else
+ * that name on the system's library path (Debian's, for /usr/bin/python3). */
+static void library_beside(const char* base_bin, int major, int minor, char* library) {
+    if (major == 0) {
+        major = PY_MAJOR_VERSION;
+        minor = PY_MINOR_VERSION;
+    }
+    char soname[64];
+    snprintf(soname, sizeof soname, "libpython%d.%d.so.1.0", major, minor);
     char candidate[PATH_MAX + 80];
-    snprintf(candidate, sizeof candidate, "%s/../lib/%s", bin, soname);
-    if (access(candidate, R_OK) == 0 && strlen(candidate) < PATH_MAX) {
+    snprintf(candidate, sizeof candidate, "%s/../lib/%s", base_bin, soname);
+    if (access(candidate, R_OK) == 0 && strlen(candidate) < PATH_MAX)
         snprintf(library, PATH_MAX, "%s", candidate);
-    } else {
+    else
         snprintf(library, PATH_MAX, "%s", soname);
+}
+
+/* The executable must be of the Python the loader was built for (PyConfig's layout is that
+ * version's); its library, when not named, is found beside it. */
+static int check_version(PythonChoice* choice, char* why) {
+    char base_bin[PATH_MAX];
+    int major, minor;
+    inspect_executable(choice->executable, base_bin, &major, &minor);
+    if (major != 0 && (major != PY_MAJOR_VERSION || minor != PY_MINOR_VERSION)) {
+        snprintf(why, WHY_SIZE,
+                 "the FMU was built for Python %d.%d, but %s (from %s) is Python %d.%d; set "
+                 "%s to a Python %d.%d executable",
+                 PY_MAJOR_VERSION, PY_MINOR_VERSION, choice->executable, choice->source, major,
+                 minor, PYTHON_VARIABLE, PY_MAJOR_VERSION, PY_MINOR_VERSION);
+        return 0;
     }
+    if (choice->library[0] == '\0') library_beside(base_bin, major, minor, choice->library);
+    return 1;
 }
 
 static int choose_python(const char* binaries, PythonChoice* choice, char* why) {
@@ -336,9 +368,8 @@ static int choose_python(const char* binaries, PythonChoice* choice, char* why) 
     const char* variable = getenv(PYTHON_VARIABLE);
     if (variable && variable[0]) {
         snprintf(choice->executable, PATH_MAX, "%s", variable);
-        library_beside(choice->executable, choice->library);
         snprintf(choice->source, sizeof choice->source, "$%s", PYTHON_VARIABLE);
-        return 1;
+        return check_version(choice, why);
     }
     char path[PATH_MAX + 64];
     snprintf(path, sizeof path, "%s/../../resources/%s", binaries, PYTHON_FILE);
@@ -365,8 +396,7 @@ static int choose_python(const char* binaries, PythonChoice* choice, char* why) 
                  "executable", PYTHON_FILE, PYTHON_VARIABLE, PY_MAJOR_VERSION, PY_MINOR_VERSION);
         return 0;
     }
-    if (choice->library[0] == '\0') library_beside(choice->executable, choice->library);
-    return 1;
+    return check_version(choice, why);
 }
 
 #define PY_FUNCTION(handle, name)                                                               \

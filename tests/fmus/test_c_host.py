@@ -10,6 +10,7 @@ master (the M739 train and verge coupled), value for value.
 from __future__ import annotations
 
 import math
+import re
 import shutil
 import subprocess
 import sys
@@ -235,7 +236,7 @@ def test_a_python_named_by_the_variable_is_started_and_its_environment_used(
     """$MECHCOSIM_PYTHON names a virtual environment without numpy (the Python it is made
     from has numpy): DetachedLever cannot load its code there, and the C host hears why at
     default logging; fmi2Instantiate returns NULL, nothing crashes.  A Python that is not
-    there is named in the log the same way."""
+    there, or of another version, is named in the log the same way."""
     bare = tmp_path / "bare"
     venv.create(bare, with_pip=False, symlinks=True)
     path = build_fmu("DetachedLever")
@@ -253,6 +254,19 @@ def test_a_python_named_by_the_variable_is_started_and_its_environment_used(
     assert "instantiate lever_a returned NULL" in out
     logged = [ln for ln in out if ln.startswith("log Error lever_a:")]
     assert logged and str(missing) in logged[0] and "MECHCOSIM_PYTHON" in logged[0], out
+
+    # A Python of another version is refused before anything of it is loaded.
+    cfg = bare / "pyvenv.cfg"
+    cfg.write_text(re.sub(r"(?m)^version.*$", "version = 3.99.0", cfg.read_text()))
+    out = run_host(host, tmp_path / "job.txt", {"MECHCOSIM_PYTHON": str(bare / "bin" / "python")})
+    assert "instantiate lever_a returned NULL" in out
+    version = f"{sys.version_info.major}.{sys.version_info.minor}"
+    assert any(
+        ln.startswith("log Error lever_a:")
+        and f"the FMU was built for Python {version}" in ln
+        and "is Python 3.99" in ln
+        for ln in out
+    ), out
 
 
 def test_without_a_c_compiler_the_build_says_so_and_the_fmu_runs_in_python_hosts(
