@@ -35,7 +35,6 @@
 #include <limits.h>
 #include <link.h>
 #include <pthread.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -174,7 +173,6 @@ static struct {
     fmi2Component (*fmi2Instantiate)(fmi2String, fmi2Type, fmi2String, fmi2String,
                                      const fmi2CallbackFunctions*, fmi2Boolean, fmi2Boolean);
     void (*fmi2FreeInstance)(fmi2Component);
-    fmi2Status (*fmi2SetDebugLogging)(fmi2Component, fmi2Boolean, size_t, const fmi2String[]);
     void (*finalizePythonInterpreter)(void);
 #define POINTER(name, params, args) fmi2Status(*name) params;
     INSTANCE_FUNCTIONS(POINTER)
@@ -523,7 +521,6 @@ static int load_runtime(const char* binaries, char* why) {
     }
     RUNTIME_FUNCTION(fmi2Instantiate);
     RUNTIME_FUNCTION(fmi2FreeInstance);
-    RUNTIME_FUNCTION(fmi2SetDebugLogging);
     INSTANCE_FUNCTIONS(RESOLVE)
     *(void**)&runtime.finalizePythonInterpreter = dlsym(handle, "finalizePythonInterpreter");
     /* The runtime is never unloaded (pythonfmu's runtime does not survive it), so neither is
