@@ -7,7 +7,9 @@
  *
  * Job file, one directive per line:
  *   sequence <start> <steps>          every FMU below in turn: the full call sequence
- *   jacobi <start> <stop> <step> <steps>   the FMUs below coupled, fixed-step Jacobi
+ *   jacobi <start> <stop> <step> <steps> [threads]   the FMUs below coupled, fixed-step
+ *                                     Jacobi; "threads": each FMU steps on a thread of its
+ *                                     own, all at once, as parallel hosts do
  *   fmu <instance> <unzipped dir> <model identifier> <guid>
  *   step <size>                       the communication step of the sequence (last fmu)
  *   set <r|i|b> <vr> <value>          a start value, set in initialization mode (last fmu)
@@ -19,6 +21,7 @@
  */
 #define _GNU_SOURCE
 #include <dlfcn.h>
+#include <pthread.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -74,6 +77,18 @@ typedef struct {
     int from, to;
     fmi2ValueReference from_vr, to_vr;
 } Connection;
+
+typedef struct {
+    Fmu* fmu;
+    double t, h;
+    fmi2Status status;
+} StepJob;
+
+static void* step_on_thread(void* data) {
+    StepJob* job = data;
+    job->status = job->fmu->do_step(job->fmu->c, job->t, job->h, fmi2True);
+    return NULL;
+}
 
 static Fmu fmus[MAX_FMUS];
 static int n_fmus;
@@ -277,7 +292,7 @@ static void sequence(Fmu* f, double start, int n) {
 }
 
 /* Fixed-step Jacobi: every FMU steps with the outputs of the last communication point. */
-static void jacobi(double start, double stop, double h, int n) {
+static void jacobi(double start, double stop, double h, int n, int threaded) {
     double held[MAX_VARS];
     fmi2Integer held_i[MAX_VARS];
     for (int j = 0; j < n_fmus; ++j) {
@@ -328,9 +343,26 @@ static void jacobi(double start, double stop, double h, int n) {
     READ_SOURCES();
     for (int k = 0; k < n; ++k) {
         double t = start + k * h;
-        for (int j = 0; j < n_fmus; ++j) {
-            FEED(j);
-            CHECK(fmus[j].do_step(fmus[j].c, t, h, fmi2True), "fmi2DoStep", fmus[j].id);
+        if (threaded) {
+            pthread_t threads[MAX_FMUS];
+            StepJob jobs[MAX_FMUS];
+            for (int j = 0; j < n_fmus; ++j) FEED(j);
+            for (int j = 0; j < n_fmus; ++j) {
+                jobs[j] = (StepJob){&fmus[j], t, h, fmi2Error};
+                if (pthread_create(&threads[j], NULL, step_on_thread, &jobs[j]) != 0) {
+                    fail("pthread_create", fmus[j].id);
+                    return;
+                }
+            }
+            for (int j = 0; j < n_fmus; ++j) {
+                pthread_join(threads[j], NULL);
+                if (jobs[j].status != fmi2OK) fail("fmi2DoStep on a thread", fmus[j].id);
+            }
+        } else {
+            for (int j = 0; j < n_fmus; ++j) {
+                FEED(j);
+                CHECK(fmus[j].do_step(fmus[j].c, t, h, fmi2True), "fmi2DoStep", fmus[j].id);
+            }
         }
         READ_SOURCES();
         for (int j = 0; j < n_fmus; ++j) print_outputs(&fmus[j], fmus[j].c, "", start + (k + 1) * h);
@@ -360,7 +392,7 @@ int main(int argc, char** argv) {
     }
     char mode[32] = "";
     double start = 0, stop = 0, h = 0;
-    int n = 0;
+    int n = 0, threaded = 0;
     char line[8192];
     while (fgets(line, sizeof line, job)) {
         char word[32];
@@ -370,7 +402,9 @@ int main(int argc, char** argv) {
             sscanf(line, "%*s %lf %d", &start, &n);
         } else if (strcmp(word, "jacobi") == 0) {
             snprintf(mode, sizeof mode, "%s", word);
-            sscanf(line, "%*s %lf %lf %lf %d", &start, &stop, &h, &n);
+            char option[32] = "";
+            sscanf(line, "%*s %lf %lf %lf %d %31s", &start, &stop, &h, &n, option);
+            threaded = strcmp(option, "threads") == 0;
         } else if (strcmp(word, "fmu") == 0) {
             Fmu* f = &fmus[n_fmus++];
             sscanf(line, "%*s %63s %4095s %255s %127s", f->name, f->dir, f->id, f->guid);
@@ -393,7 +427,7 @@ int main(int argc, char** argv) {
     if (strcmp(mode, "sequence") == 0) {
         for (int j = 0; j < n_fmus; ++j) sequence(&fmus[j], start, n);
     } else if (strcmp(mode, "jacobi") == 0) {
-        jacobi(start, stop, h, n);
+        jacobi(start, stop, h, n, threaded);
     }
     printf("done %d failures\n", failures);
     return failures ? 1 : 0;
