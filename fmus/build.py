@@ -7,7 +7,10 @@ named after the hash too.  So any number of our FMUs, and two builds of one FMU 
 different code, run each their own code in one process.  The third-party modules that
 code imports are written to ``resources/requirements.txt`` (pythonfmu's deploy command
 installs them), and ``documentation/index.html`` tells a user of another tool how to use
-the FMU.  ``fmus.description`` completes the model description.
+the FMU.  ``fmus.description`` completes the model description.  On Linux the FMU's binary
+is a small loader (``fmus.host_loader``) that starts Python where the host has none and
+forwards to pythonfmu's runtime, so the FMU loads in C and C++ hosts too.  The archive's
+entries carry a fixed date: the same sources and build environment give the same file.
 """
 
 from __future__ import annotations
@@ -19,6 +22,7 @@ import re
 import shutil
 import sys
 import tempfile
+import uuid
 import zipfile
 from functools import cache
 from pathlib import Path
@@ -31,6 +35,7 @@ from pythonfmu.builder import FmuBuilder
 from components.base import Component
 from fmus.description import complete_description
 from fmus.documentation import render_documentation
+from fmus.host_loader import LOADER_SOURCE, loader_binary, loader_plan, pack_loader
 from fmus.registry import FMU_WRAPPERS, FmuWrapper
 
 FMUS_DIR = Path(__file__).resolve().parent
@@ -44,7 +49,11 @@ BUILD_CODE = (
     FMUS_DIR / "description.py",
     FMUS_DIR / "documentation.py",
     FMUS_DIR / "units.py",
+    FMUS_DIR / "host_loader.py",
+    LOADER_SOURCE,
 )
+#: the date of every entry of an FMU archive (the earliest a zip file can hold)
+ZIP_DATE = (1980, 1, 1, 0, 0, 0)
 #: Requirement lines for the third-party modules component code may import.
 REQUIREMENTS = {"numpy": "numpy>=1.26", "scipy": "scipy>=1.11"}
 
@@ -118,6 +127,7 @@ def content_hash(wrapper: FmuWrapper) -> str:
     for example in wrapper.examples:  # the documentation lists their connections
         h.update((PROJECT_DIR / example).read_bytes())
     h.update(pythonfmu.__version__.encode())
+    h.update(loader_plan().identity.encode())  # the compiler and the Python it names
     return h.hexdigest()
 
 
@@ -183,7 +193,10 @@ def _build(wrapper: FmuWrapper, digest: str, tmp: Path) -> Path:
     docs = tmp / "documentation"
     docs.mkdir()
     component_class = wrapper.component_class()
-    (docs / "index.html").write_text(render_documentation(wrapper, component_class, needs))
+    loader = loader_binary(wrapper.name)
+    (docs / "index.html").write_text(
+        render_documentation(wrapper, component_class, needs, loader=loader is not None)
+    )
     modules_before = set(sys.modules)
     try:
         built = FmuBuilder.build_FMU(
@@ -200,20 +213,31 @@ def _build(wrapper: FmuWrapper, digest: str, tmp: Path) -> Path:
                 del sys.modules[module]
         while str(stage) in sys.path:
             sys.path.remove(str(stage))
-    _rewrite_description(Path(built), component_class)
+    _finish(Path(built), component_class, wrapper.name, digest, loader)
     return Path(built)
 
 
-def _rewrite_description(fmu: Path, component_class: type[Component]) -> None:
+def _finish(
+    fmu: Path, component_class: type[Component], name: str, digest: str, loader: bytes | None
+) -> None:
+    """Complete the model description, put the loader in, and write the archive anew."""
     with zipfile.ZipFile(fmu) as z:
         members = {n: z.read(n) for n in z.namelist()}
     root = ET.fromstring(members["modelDescription.xml"])
+    # pythonfmu's GUID and date are of the moment: the GUID follows the content instead
+    root.set("guid", str(uuid.uuid5(uuid.NAMESPACE_URL, f"mechcosim:{name}:{digest}")))
+    root.attrib.pop("generationDateAndTime", None)
     for element in root.iter():  # drop pythonfmu's indentation before printing anew
         element.text = element.text.strip() if element.text else None
         element.tail = None
     complete_description(root, component_class)
     xml = parseString(ET.tostring(root, "UTF-8")).toprettyxml(indent="  ", encoding="UTF-8")
     members["modelDescription.xml"] = xml
+    if loader is not None:
+        pack_loader(members, name, loader)
     with zipfile.ZipFile(fmu, "w", zipfile.ZIP_DEFLATED) as z:
-        for n, data in members.items():
-            z.writestr(n, data)
+        for n in sorted(members):
+            info = zipfile.ZipInfo(n, ZIP_DATE)
+            info.compress_type = zipfile.ZIP_DEFLATED
+            info.external_attr = (0o755 if n.startswith("binaries/") else 0o644) << 16
+            z.writestr(info, members[n])

@@ -15,9 +15,10 @@ Python into fmi2Fatal, after which the instance cannot be used (a later call may
 host), and a ``do_step`` that returns False into fmi2Discard.  So a step of non-positive
 or non-finite size, from a non-finite time, or with a non-finite Real set on the FMU since
 the last step, is refused with fmi2Discard and nothing changes: the instance stays usable.
-Non-finite parameters fail initialization.  The reason goes to the FMU's log, which
-pythonfmu's runtime forwards to the host only when debug logging is on; a missing module,
-which ends instantiation before any logging, is also written to standard error.
+Non-finite parameters fail initialization.  The reason goes to the FMU's log, which the
+FMU's loader (``fmus.host_loader``) passes to the host at any logging setting (pythonfmu's
+runtime alone, in a build without the loader, only with debug logging on); a missing
+module, which ends instantiation before any logging, is also written to standard error.
 
 The runtime also corrupts the heap when a process exits with its library still loaded
 (see ``release_runtime_at_exit``); each instance arranges the remedy.
@@ -282,6 +283,9 @@ def _release_runtime(library: str) -> None:
         return
     try:
         runtime = ctypes.CDLL(library, mode=os.RTLD_NOLOAD | os.RTLD_NOW)
-    except OSError:
-        return  # unloaded already, its destructors run in order
-    runtime.finalizePythonInterpreter()
+        release = runtime.finalizePythonInterpreter
+    except (OSError, AttributeError):
+        # unloaded already, its destructors run in order; or the FMU's loader, which
+        # releases the runtime beside it by itself
+        return
+    release()

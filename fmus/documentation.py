@@ -49,9 +49,14 @@ class DocumentationError(RuntimeError):
 
 # -- public entry point ---------------------------------------------------------------------
 def render_documentation(
-    wrapper: FmuWrapper, component_class: type[Component], requirements: list[str]
+    wrapper: FmuWrapper,
+    component_class: type[Component],
+    requirements: list[str],
+    loader: bool = True,
 ) -> str:
-    """The FMU's ``documentation/index.html``: a complete, standalone HTML5 page."""
+    """The FMU's ``documentation/index.html``: a complete, standalone HTML5 page.
+    ``loader``: the FMU's Linux binary is the loader (``fmus.host_loader``) that lets hosts
+    without Python run it, not pythonfmu's runtime alone."""
     slave = _slave_metadata(wrapper.script)
     description = (slave.description or _first_line(component_class.__doc__)).rstrip(".")
     examples = [_read_example(wrapper, path) for path in wrapper.examples]
@@ -62,7 +67,7 @@ def render_documentation(
         ("variables", "Variables", _variables_section(component_class)),
         ("regimes", "Regimes and events", _regimes_section(wrapper, component_class)),
         ("coupling", "How to couple it", _coupling_section(wrapper, examples)),
-        ("host", "Host requirements", _host_section(wrapper, requirements)),
+        ("host", "Host requirements", _host_section(wrapper, requirements, loader)),
         ("tools", "Usage in other tools", _tools_section(wrapper, component_class, slave)),
         ("capabilities", "FMI capabilities", _capabilities_section()),
     ]
@@ -382,7 +387,7 @@ def _coupling_section(wrapper: FmuWrapper, examples: list[_Example]) -> str:
     return rule + intro + "".join(_example_html(wrapper, ex) for ex in examples)
 
 
-def _host_section(wrapper: FmuWrapper, requirements: list[str]) -> str:
+def _host_section(wrapper: FmuWrapper, requirements: list[str], loader: bool) -> str:
     if requirements:
         reqs = "".join(f"<li><code>{escape(r)}</code></li>" for r in requirements)
         reqs = f"<ul>{reqs}</ul>\n"
@@ -392,33 +397,56 @@ def _host_section(wrapper: FmuWrapper, requirements: list[str]) -> str:
         reqs = "<p>No packages beyond the standard library.</p>\n"
         install_cmd = ""
     fmu = f"{wrapper.name}.fmu"
-    libdir = (
-        "python3 -c \"import sysconfig; print(sysconfig.get_config_var('LIBDIR'), "
-        "sysconfig.get_config_var('LDLIBRARY'))\""
-    )
+    version = f"{sys.version_info.major}.{sys.version_info.minor}"
+    if loader:
+        other_hosts = (
+            "<li><strong>Other hosts on Linux</strong> (libcosim's <code>cosim</code> command "
+            "line, the FMI Compliance Checker, OMSimulator, a C/C++ tool): nothing to set up "
+            "on the machine that built the FMU, no <code>LD_PRELOAD</code>, no "
+            "<code>PYTHONPATH</code>. The FMU's binary is a small loader: where the host "
+            "process has no Python, it loads the Python that built the FMU (named in "
+            "<code>resources/python.txt</code>: its executable and its shared libpython), "
+            "starts it as that executable starts (a virtual environment's packages "
+            "included) and runs the FMU's code in it. Elsewhere, name a Python "
+            f"{escape(version)} that has the packages:"
+            f"<pre>MECHCOSIM_PYTHON=/path/to/venv/bin/python</pre>"
+            "Its libpython is looked for in the <code>lib/</code> of its base installation, "
+            "then on the system's library path; or write both lines "
+            "(<code>executable=</code>, <code>library=</code>) into "
+            "<code>resources/python.txt</code> inside the FMU. The first FMU that starts "
+            "Python in a process starts it for all.</li>\n"
+        )
+        errors = (
+            "<li>Whatever the FMU logs with a status other than fmi2OK reaches the host's "
+            "logger with debug logging off too. A missing package, or a Python that cannot "
+            "be found or started, makes <code>fmi2Instantiate</code> return NULL with the "
+            "reason logged (fmi2Error or fmi2Fatal).</li>\n"
+        )
+    else:
+        other_hosts = (
+            "<li><strong>Other hosts</strong>: this build's Linux binary is pythonfmu's "
+            "runtime alone (no C compiler where it was built), which does not link libpython: "
+            "it loads only in a process that has Python already. Build the FMU where a C "
+            "compiler is found to get the binary that loads in any host.</li>\n"
+        )
+        errors = (
+            "<li>A missing module is reported when the FMU is instantiated, on standard "
+            "error; the FMU's log reaches the host only with debug logging on.</li>\n"
+        )
     return (
-        "<p>The FMU's binary is pythonfmu's runtime: it runs the FMU's Python code "
-        "(packed in <code>resources/</code>) in the Python interpreter of the host "
-        "process. It needs <strong>Python 3.11 or later</strong> with these packages, "
-        "installed into the Python that the host loads:</p>\n"
+        "<p>The FMU's code is Python, run by pythonfmu's runtime (the code is packed in "
+        "<code>resources/</code>). It needs <strong>Python 3.11 or later</strong> with these "
+        "packages:</p>\n"
         f"{reqs}"
         + (f"<pre>{escape(install_cmd)}</pre>\n" if install_cmd else "")
         + "<p>The same list is packed as <code>resources/requirements.txt</code>; "
         f"<code>pythonfmu deploy -f {escape(fmu)}</code>, run with that Python, installs "
         "it.</p>\n"
         "<ul>\n"
-        "<li><strong>Python hosts</strong> (FMPy, libcosimpy, a Python master): the "
-        "interpreter is already loaded; install the packages into that same "
-        "environment.</li>\n"
-        "<li><strong>Non-Python hosts</strong> (libcosim's <code>cosim</code> command line, "
-        "a C/C++ tool): the binary does not link libpython itself, so libpython must be "
-        "loadable in the host process. On Linux preload it, e.g. "
-        "<code>LD_PRELOAD=/path/to/libpython3.11.so</code>; this prints where it is:"
-        f"<pre>{escape(libdir)}</pre>"
-        "The packages must then be installed in that Python (for a virtual environment, "
-        "add its <code>site-packages</code> to <code>PYTHONPATH</code>).</li>\n"
-        "<li>A missing module is reported in the FMU's log (fmi2Error) when the FMU is "
-        "instantiated, with the interpreter that ran it; instantiation then fails.</li>\n"
+        "<li><strong>Python hosts</strong> (FMPy, libcosimpy, a Python master): the FMU "
+        "runs in the host's own interpreter, whether its executable links libpython or has "
+        "it built in; install the packages into that same environment.</li>\n"
+        f"{other_hosts}{errors}"
         "</ul>\n"
     )
 
@@ -453,7 +481,7 @@ def _tools_section(wrapper: FmuWrapper, cls: type[Component], slave: _SlaveMetad
     )
     cosim_values = " ".join(f"{v.name}={_number(v.start, v.type)}" for v in params)
     cosim = (
-        f"LD_PRELOAD=/path/to/libpython3.11.so cosim run-single {fmu} {cosim_values} "
+        f"cosim run-single {fmu} {cosim_values} "
         f"-b {_g(start)} -d {_g(stop - start)} -s {_g(step)} --output-file {wrapper.name}.csv"
     )
     libcosim = "\n".join(
@@ -480,7 +508,7 @@ def _tools_section(wrapper: FmuWrapper, cls: type[Component], slave: _SlaveMetad
         "<p>From Python:</p>\n"
         f"<pre>{escape(snippet)}</pre>\n"
         "<h3>libcosim</h3>\n"
-        "<p>libcosimpy (a Python host: nothing to preload) adds each FMU with "
+        "<p>libcosimpy (a Python host) adds each FMU with "
         "<code>CosimExecution.from_step_size</code> (step in integer nanoseconds) and "
         "<code>add_local_slave</code>, finds value references by name through "
         "<code>slave_variables</code>, and joins the connections of "

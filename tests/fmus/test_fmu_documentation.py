@@ -204,7 +204,11 @@ def test_host_requirements_and_tool_commands() -> None:
     for line in REQUIREMENTS:
         assert line.replace(">", "&gt;") in html
     for text in (
-        "LD_PRELOAD=/path/to/libpython3.11.so",
+        "MECHCOSIM_PYTHON=/path/to/venv/bin/python",
+        "resources/python.txt",
+        "no <code>LD_PRELOAD</code>",
+        "cosim run-single GearTrain.fmu mu=0.1",
+        "with debug logging off too",
         "pythonfmu deploy -f GearTrain.fmu",
         "fmpy info GearTrain.fmu",
         "fmpy simulate GearTrain.fmu --start-values mu 0.1",
@@ -214,6 +218,14 @@ def test_host_requirements_and_tool_commands() -> None:
         "fmi2Error",
     ):
         assert text in html, text
+    assert "LD_PRELOAD=" not in html
+
+
+def test_a_build_without_the_loader_says_which_hosts_it_loads_in() -> None:
+    html = render_documentation(
+        FMU_WRAPPERS["GearTrain"], component_class("GearTrain"), REQUIREMENTS, loader=False
+    )
+    assert "pythonfmu's runtime alone" in html and "MECHCOSIM_PYTHON" not in html
 
 
 def test_a_missing_example_scene_is_an_error() -> None:

@@ -51,6 +51,15 @@ def test_build_is_cached_by_content(fmu_cache) -> None:
     assert content_hash(FMU_WRAPPERS["Inertia"])[:16] in first.name
 
 
+def test_a_build_is_the_same_file_each_time(tmp_path) -> None:
+    """Same sources, same environment: same bytes (entry dates, GUID and loader included)."""
+    first = build_fmu("Inertia", tmp_path).read_bytes()
+    again = build_fmu("Inertia", tmp_path, force=True).read_bytes()
+    assert first == again
+    guid = read_model_description(str(build_fmu("Inertia", tmp_path))).guid
+    assert guid == read_model_description(str(build_fmu("Inertia", tmp_path / "b"))).guid
+
+
 def test_many_instances_in_one_process(fmu_cache) -> None:
     # pythonfmu's runtime mishandles a reference on each instantiation; the slave
     # compensates, so instantiating many times in a process must stay safe.

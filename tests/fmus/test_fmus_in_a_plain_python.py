@@ -1,8 +1,9 @@
 """Every FMU runs in a fresh virtual environment that has fmpy, pythonfmu and numpy (plus
 what the FMU's requirements.txt names) but not this project, as a user of another tool
 would have it; two of them in one process.  A missing requirement is named on standard
-error, and the process exits without touching freed memory.  Slow: it installs packages
-into a new environment.
+error, and the process exits without touching freed memory.  In a Python whose executable
+has the interpreter built in (Debian's), the FMUs use that interpreter and load no
+libpython.  Slow: it installs packages into a new environment.
 """
 
 from __future__ import annotations
@@ -27,7 +28,7 @@ pytestmark = pytest.mark.slow
 # Runs inside the plain environment: simulate each FMU named on the command line in this
 # one process and report what happened.
 PROBE = """
-import json, sys
+import json, re, sys
 from fmpy import simulate_fmu
 report = {}
 try:
@@ -41,6 +42,8 @@ for path in sys.argv[1:]:
         report[path] = ["ok", len(result)]
     except Exception as exc:
         report[path] = ["failed", str(exc)]
+with open("/proc/self/maps") as maps:  # interpreters mapped (not pythonfmu's runtime)
+    report["libpython mapped"] = sorted(set(re.findall(r"/libpython3[^/\\s]*", maps.read())))
 print(json.dumps(report))
 """
 
@@ -88,6 +91,7 @@ def test_every_fmu_runs_in_a_plain_python(plain_python: Path, tmp_path: Path) ->
 
     report, stderr = probe(python, [*numpy_only, *needs_scipy], tmp_path)
     assert report.pop("project importable") is False
+    assert len(report.pop("libpython mapped")) == 1  # the one its executable links
     for path in numpy_only:
         assert report[str(path)] == ["ok", 11], path
     # Those that import scipy when loaded are refused, and the reason is named (some import
@@ -123,3 +127,45 @@ def test_the_process_exits_without_touching_freed_memory(
     blocks = re.split(r"\n==\d+== \n", run.stderr)
     in_fmu = [b for b in blocks if "Invalid" in b and "binaries/linux64" in b]
     assert not in_fmu, in_fmu[0]
+
+
+def static_python() -> Path | None:
+    """A Python 3.11+ whose executable has the interpreter built in (links no libpython),
+    if this machine has one: Debian's /usr/bin/python3 is such a Python."""
+    if shutil.which("ldd") is None:
+        return None
+    for candidate in sorted(Path("/usr/bin").glob("python3.[0-9]*")):
+        if not re.fullmatch(r"python3\.\d+", candidate.name) or int(candidate.name[8:]) < 11:
+            continue
+        linked = subprocess.run(["ldd", str(candidate)], capture_output=True, text=True)
+        if linked.returncode == 0 and "libpython" not in linked.stdout:
+            return candidate
+    return None
+
+
+STATIC_PYTHON = static_python()
+
+
+@pytest.mark.skipif(
+    STATIC_PYTHON is None,
+    reason="no Python 3.11+ here whose executable links no libpython (Debian's python3 is one)",
+)
+def test_fmus_run_in_fmpy_in_a_python_with_the_interpreter_built_in(
+    tmp_path_factory: pytest.TempPathFactory, tmp_path: Path
+) -> None:
+    """The FMU's binary finds the interpreter the executable has built in and loads no
+    libpython beside it (a second interpreter in one process would crash)."""
+    env = tmp_path_factory.mktemp("static") / "venv"
+    made = subprocess.run(
+        [str(STATIC_PYTHON), "-m", "venv", str(env)], capture_output=True, text=True
+    )
+    if made.returncode != 0:
+        pytest.skip(f"{STATIC_PYTHON} cannot make a virtual environment: {made.stderr.strip()}")
+    python = env / "bin" / "python"
+    pip(python, "fmpy", "numpy")
+    fmus = [build_fmu("Inertia"), build_fmu("DetachedLever")]  # the second imports numpy
+    report, stderr = probe(python, fmus, tmp_path)
+    assert report.pop("project importable") is False
+    assert report.pop("libpython mapped") == [], "a libpython was loaded beside the built-in one"
+    for path in fmus:
+        assert report[str(path)] == ["ok", 11], (path, stderr)

@@ -1,0 +1,654 @@
+/*
+ * The Linux binary of every mechcosim FMU (binaries/linux64/<model>.so).
+ *
+ * pythonfmu's runtime (packed beside this file as libpythonfmu-export.so) runs the FMU's
+ * Python code in the interpreter of the host process, but does not link libpython: a host
+ * that is not Python (a C or C++ tool) cannot even load it ("undefined symbol:
+ * _Py_NoneStruct").  This loader is what the host loads instead.  On the first
+ * fmi2Instantiate it makes sure the process has a running Python, then loads the runtime and
+ * forwards every FMI 2.0 call to it:
+ *
+ *   1. Python already in the process (a Python host, whether its executable links libpython
+ *      or has it built in): use it.  The loader never loads a second libpython.
+ *   2. Else load the shared libpython named in resources/python.txt (written at build time,
+ *      the Python that built the FMU) or found beside $MECHCOSIM_PYTHON, globally, and start
+ *      it as that Python's executable would start: a virtual environment's pyvenv.cfg is
+ *      read, so its site-packages (the FMU's requirements) resolve.
+ *
+ * The loader also passes on what the runtime logs: every message whose status is not fmi2OK
+ * reaches the host's logger whatever the logging setting (the runtime alone forwards
+ * nothing unless debug logging is on), fmi2OK messages only with debug logging on.  A
+ * failure of its own (no Python, a wrong version) is logged to the host and fmi2Instantiate
+ * returns NULL.  After the runtime answers fmi2Fatal the instance is not passed to it again
+ * (the runtime has released its Python objects and would crash): further calls return
+ * fmi2Error and fmi2FreeInstance frees only what the loader holds.
+ *
+ * Compiled at build time against the headers of the Python that builds the FMU (PyConfig's
+ * layout is that version's), without linking libpython: every Python function is looked up
+ * at run time.
+ */
+#define _GNU_SOURCE
+#define PY_SSIZE_T_CLEAN
+#include <Python.h>
+
+#include <dlfcn.h>
+#include <limits.h>
+#include <link.h>
+#include <pthread.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#define EXPORT __attribute__((visibility("default")))
+#define RUNTIME_FILE "libpythonfmu-export.so"
+#define PYTHON_FILE "python.txt"
+#define PYTHON_VARIABLE "MECHCOSIM_PYTHON"
+#define WHY_SIZE 2048
+
+/* -- FMI 2.0 types (as the standard defines them) --------------------------------------- */
+typedef void* fmi2Component;
+typedef void* fmi2ComponentEnvironment;
+typedef void* fmi2FMUstate;
+typedef unsigned int fmi2ValueReference;
+typedef double fmi2Real;
+typedef int fmi2Integer;
+typedef int fmi2Boolean;
+typedef char fmi2Char;
+typedef const fmi2Char* fmi2String;
+typedef char fmi2Byte;
+typedef enum { fmi2OK, fmi2Warning, fmi2Discard, fmi2Error, fmi2Fatal, fmi2Pending } fmi2Status;
+typedef enum { fmi2ModelExchange, fmi2CoSimulation } fmi2Type;
+typedef enum {
+    fmi2DoStepStatus,
+    fmi2PendingStatus,
+    fmi2LastSuccessfulTime,
+    fmi2Terminated
+} fmi2StatusKind;
+typedef void (*fmi2CallbackLogger)(fmi2ComponentEnvironment, fmi2String, fmi2Status, fmi2String,
+                                   fmi2String, ...);
+typedef void* (*fmi2CallbackAllocateMemory)(size_t, size_t);
+typedef void (*fmi2CallbackFreeMemory)(void*);
+typedef void (*fmi2StepFinished)(fmi2ComponentEnvironment, fmi2Status);
+typedef struct {
+    fmi2CallbackLogger logger;
+    fmi2CallbackAllocateMemory allocateMemory;
+    fmi2CallbackFreeMemory freeMemory;
+    fmi2StepFinished stepFinished;
+    fmi2ComponentEnvironment componentEnvironment;
+} fmi2CallbackFunctions;
+
+/* An instance as the host sees it: the runtime's instance and how to log for it. */
+typedef struct {
+    fmi2Component inner;
+    fmi2CallbackFunctions host;    /* the host's callbacks, copied */
+    fmi2CallbackFunctions relayed; /* given to the runtime: its messages come through relay() */
+    char* name;
+    int debug;          /* the host's debug logging setting */
+    size_t n_categories; /* 0: all categories */
+    char** categories;
+    int failed;         /* the runtime answered fmi2Fatal: do not call it again */
+} Instance;
+
+/* The functions that take an instance, with how the loader calls the runtime's. */
+#define INSTANCE_FUNCTIONS(X)                                                                   \
+    X(fmi2SetupExperiment,                                                                      \
+      (fmi2Component c, fmi2Boolean toleranceDefined, fmi2Real tolerance, fmi2Real startTime,   \
+       fmi2Boolean stopTimeDefined, fmi2Real stopTime),                                         \
+      (i->inner, toleranceDefined, tolerance, startTime, stopTimeDefined, stopTime))            \
+    X(fmi2EnterInitializationMode, (fmi2Component c), (i->inner))                               \
+    X(fmi2ExitInitializationMode, (fmi2Component c), (i->inner))                                \
+    X(fmi2Terminate, (fmi2Component c), (i->inner))                                             \
+    X(fmi2Reset, (fmi2Component c), (i->inner))                                                 \
+    X(fmi2GetReal, (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Real v[]),  \
+      (i->inner, vr, nvr, v))                                                                   \
+    X(fmi2GetInteger,                                                                           \
+      (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Integer v[]),            \
+      (i->inner, vr, nvr, v))                                                                   \
+    X(fmi2GetBoolean,                                                                           \
+      (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Boolean v[]),            \
+      (i->inner, vr, nvr, v))                                                                   \
+    X(fmi2GetString,                                                                            \
+      (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2String v[]),             \
+      (i->inner, vr, nvr, v))                                                                   \
+    X(fmi2SetReal,                                                                              \
+      (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Real v[]),         \
+      (i->inner, vr, nvr, v))                                                                   \
+    X(fmi2SetInteger,                                                                           \
+      (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Integer v[]),      \
+      (i->inner, vr, nvr, v))                                                                   \
+    X(fmi2SetBoolean,                                                                           \
+      (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Boolean v[]),      \
+      (i->inner, vr, nvr, v))                                                                   \
+    X(fmi2SetString,                                                                            \
+      (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2String v[]),       \
+      (i->inner, vr, nvr, v))                                                                   \
+    X(fmi2GetFMUstate, (fmi2Component c, fmi2FMUstate * state), (i->inner, state))              \
+    X(fmi2SetFMUstate, (fmi2Component c, fmi2FMUstate state), (i->inner, state))                \
+    X(fmi2FreeFMUstate, (fmi2Component c, fmi2FMUstate * state), (i->inner, state))            \
+    X(fmi2SerializedFMUstateSize, (fmi2Component c, fmi2FMUstate state, size_t * size),        \
+      (i->inner, state, size))                                                                  \
+    X(fmi2SerializeFMUstate,                                                                    \
+      (fmi2Component c, fmi2FMUstate state, fmi2Byte bytes[], size_t size),                     \
+      (i->inner, state, bytes, size))                                                           \
+    X(fmi2DeSerializeFMUstate,                                                                  \
+      (fmi2Component c, const fmi2Byte bytes[], size_t size, fmi2FMUstate * state),             \
+      (i->inner, bytes, size, state))                                                           \
+    X(fmi2GetDirectionalDerivative,                                                             \
+      (fmi2Component c, const fmi2ValueReference unknown[], size_t n_unknown,                   \
+       const fmi2ValueReference known[], size_t n_known, const fmi2Real dv_known[],             \
+       fmi2Real dv_unknown[]),                                                                  \
+      (i->inner, unknown, n_unknown, known, n_known, dv_known, dv_unknown))                     \
+    X(fmi2SetRealInputDerivatives,                                                              \
+      (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Integer order[],   \
+       const fmi2Real v[]),                                                                     \
+      (i->inner, vr, nvr, order, v))                                                            \
+    X(fmi2GetRealOutputDerivatives,                                                             \
+      (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Integer order[],   \
+       fmi2Real v[]),                                                                           \
+      (i->inner, vr, nvr, order, v))                                                            \
+    X(fmi2DoStep,                                                                               \
+      (fmi2Component c, fmi2Real currentCommunicationPoint, fmi2Real communicationStepSize,     \
+       fmi2Boolean noSetFMUStatePriorToCurrentCommunicationPoint),                              \
+      (i->inner, currentCommunicationPoint, communicationStepSize,                              \
+       noSetFMUStatePriorToCurrentCommunicationPoint))                                          \
+    X(fmi2CancelStep, (fmi2Component c), (i->inner))                                            \
+    X(fmi2GetStatus, (fmi2Component c, const fmi2StatusKind s, fmi2Status * v),                 \
+      (i->inner, s, v))                                                                         \
+    X(fmi2GetRealStatus, (fmi2Component c, const fmi2StatusKind s, fmi2Real * v),               \
+      (i->inner, s, v))                                                                         \
+    X(fmi2GetIntegerStatus, (fmi2Component c, const fmi2StatusKind s, fmi2Integer * v),         \
+      (i->inner, s, v))                                                                         \
+    X(fmi2GetBooleanStatus, (fmi2Component c, const fmi2StatusKind s, fmi2Boolean * v),         \
+      (i->inner, s, v))                                                                         \
+    X(fmi2GetStringStatus, (fmi2Component c, const fmi2StatusKind s, fmi2String * v),           \
+      (i->inner, s, v))
+
+#define DECLARE(name, params, args) EXPORT fmi2Status name params;
+INSTANCE_FUNCTIONS(DECLARE)
+
+/* The runtime's entry points, found once. */
+static struct {
+    void* handle;
+    fmi2Component (*fmi2Instantiate)(fmi2String, fmi2Type, fmi2String, fmi2String,
+                                     const fmi2CallbackFunctions*, fmi2Boolean, fmi2Boolean);
+    void (*fmi2FreeInstance)(fmi2Component);
+    void (*finalizePythonInterpreter)(void);
+#define POINTER(name, params, args) fmi2Status(*name) params;
+    INSTANCE_FUNCTIONS(POINTER)
+} runtime;
+
+/* The Python functions the loader itself calls. */
+static struct {
+    int (*Py_IsInitialized)(void);
+    const char* (*Py_GetVersion)(void);
+    void (*PyConfig_InitPythonConfig)(PyConfig*);
+    PyStatus (*PyConfig_SetBytesString)(PyConfig*, wchar_t**, const char*);
+    PyStatus (*Py_InitializeFromConfig)(const PyConfig*);
+    void (*PyConfig_Clear)(PyConfig*);
+    int (*PyStatus_Exception)(PyStatus);
+    PyThreadState* (*PyEval_SaveThread)(void);
+} py;
+
+static pthread_mutex_t prepare_lock = PTHREAD_MUTEX_INITIALIZER;
+
+/* -- logging ------------------------------------------------------------------------------ */
+static const char* status_category(fmi2Status status) {
+    switch (status) {
+        case fmi2Warning: return "logStatusWarning";
+        case fmi2Discard: return "logStatusDiscard";
+        case fmi2Error: return "logStatusError";
+        case fmi2Fatal: return "logStatusFatal";
+        default: return "logAll";
+    }
+}
+
+/* The host's logger takes a printf format: a message is passed as one, its '%' doubled. */
+static void emit(const fmi2CallbackFunctions* host, fmi2String name, fmi2Status status,
+                 fmi2String category, const char* message) {
+    if (host == NULL || host->logger == NULL) return;
+    if (category == NULL || category[0] == '\0') category = status_category(status);
+    if (message == NULL) message = "";
+    if (strchr(message, '%') == NULL) {
+        host->logger(host->componentEnvironment, name, status, category, message);
+        return;
+    }
+    size_t n = strlen(message);
+    char* escaped = malloc(2 * n + 1);
+    if (escaped == NULL) return;
+    char* out = escaped;
+    for (const char* p = message; *p; ++p) {
+        *out++ = *p;
+        if (*p == '%') *out++ = '%';
+    }
+    *out = '\0';
+    host->logger(host->componentEnvironment, name, status, category, escaped);
+    free(escaped);
+}
+
+/* What the runtime logs for an instance: every message that is not fmi2OK, the others as
+ * the host's debug logging setting says. */
+static void relay(fmi2ComponentEnvironment env, fmi2String name, fmi2Status status,
+                  fmi2String category, fmi2String message, ...) {
+    Instance* i = env;
+    if (i == NULL) return;
+    if (status == fmi2OK) {
+        if (!i->debug) return;
+        if (i->n_categories > 0) {
+            size_t k = 0;
+            while (k < i->n_categories && !(category && strcmp(category, i->categories[k]) == 0))
+                ++k;
+            if (k == i->n_categories) return;
+        }
+    }
+    emit(&i->host, name ? name : i->name, status, category, message);
+}
+
+/* -- finding Python ------------------------------------------------------------------------ */
+/* The directory this binary is in (binaries/linux64 of the unpacked FMU). */
+static int own_directory(char* dir, size_t size, char* why) {
+    Dl_info info;
+    if (dladdr((void*)&own_directory, &info) == 0 || info.dli_fname == NULL) {
+        snprintf(why, WHY_SIZE, "cannot tell where the FMU's binary is (dladdr failed)");
+        return 0;
+    }
+    char resolved[PATH_MAX];
+    if (realpath(info.dli_fname, resolved) == NULL) {
+        snprintf(why, WHY_SIZE, "cannot resolve the path of the FMU's binary %s", info.dli_fname);
+        return 0;
+    }
+    char* slash = strrchr(resolved, '/');
+    if (slash) *slash = '\0';
+    snprintf(dir, size, "%s", resolved);
+    return 1;
+}
+
+static int find_libpython(struct dl_phdr_info* info, size_t size, void* data) {
+    (void)size;
+    const char* base = info->dlpi_name ? strrchr(info->dlpi_name, '/') : NULL;
+    base = base ? base + 1 : info->dlpi_name;
+    if (base && strncmp(base, "libpython3", 10) == 0 && strstr(base, ".so")) {
+        snprintf((char*)data, PATH_MAX, "%s", info->dlpi_name);
+        return 1;
+    }
+    return 0;
+}
+
+/* The Python this FMU starts where the process has none: $MECHCOSIM_PYTHON, else the
+ * executable and library that resources/python.txt names. */
+typedef struct {
+    char executable[PATH_MAX];
+    char library[PATH_MAX];
+    char source[PATH_MAX + 64]; /* where the choice came from, for messages */
+} PythonChoice;
+
+static void trim(char* s) {
+    size_t n = strlen(s);
+    while (n > 0 && (s[n - 1] == '\n' || s[n - 1] == '\r' || s[n - 1] == ' ')) s[--n] = '\0';
+}
+
+/* What can be told of a Python executable without running it: the directory of its base
+ * installation's executable (a virtual environment's pyvenv.cfg names it as "home") and its
+ * version (pyvenv.cfg's "version", else the name python3.X the executable resolves to;
+ * 0.0 when neither says). */
+static void inspect_executable(const char* executable, char* base_bin, int* major, int* minor) {
+    *major = *minor = 0;
+    char dir[PATH_MAX];
+    snprintf(dir, sizeof dir, "%s", executable);
+    char* slash = strrchr(dir, '/');
+    if (slash) *slash = '\0';
+    char real[PATH_MAX] = "";
+    if (realpath(executable, real)) {
+        const char* name = strrchr(real, '/') ? strrchr(real, '/') + 1 : real;
+        sscanf(name, "python%d.%d", major, minor);
+        slash = strrchr(real, '/');
+        if (slash) *slash = '\0';
+        snprintf(base_bin, PATH_MAX, "%s", real);
+    } else {
+        snprintf(base_bin, PATH_MAX, "%s", dir);
+    }
+    char cfg_path[PATH_MAX + 16];
+    snprintf(cfg_path, sizeof cfg_path, "%s/../pyvenv.cfg", dir);
+    FILE* cfg = fopen(cfg_path, "r");
+    if (cfg == NULL) return;
+    char line[PATH_MAX + 32];
+    while (fgets(line, sizeof line, cfg)) {
+        char* value = strchr(line, '=');
+        if (value == NULL) continue;
+        value++;
+        while (*value == ' ') value++;
+        trim(value);
+        if (strncmp(line, "home", 4) == 0)
+            snprintf(base_bin, PATH_MAX, "%s", value);
+        else if (strncmp(line, "version", 7) == 0)
+            sscanf(value, "%d.%d", major, minor);
+    }
+    fclose(cfg);
+}
+
+/* The shared libpython of an executable: <base installation>/lib/libpython3.X.so.1.0, else
+ * that name on the system's library path (Debian's, for /usr/bin/python3). */
+static void library_beside(const char* base_bin, int major, int minor, char* library) {
+    if (major == 0) {
+        major = PY_MAJOR_VERSION;
+        minor = PY_MINOR_VERSION;
+    }
+    char soname[64];
+    snprintf(soname, sizeof soname, "libpython%d.%d.so.1.0", major, minor);
+    char candidate[PATH_MAX + 80];
+    snprintf(candidate, sizeof candidate, "%s/../lib/%s", base_bin, soname);
+    if (access(candidate, R_OK) == 0 && strlen(candidate) < PATH_MAX)
+        snprintf(library, PATH_MAX, "%s", candidate);
+    else
+        snprintf(library, PATH_MAX, "%s", soname);
+}
+
+/* The executable must be of the Python the loader was built for (PyConfig's layout is that
+ * version's); its library, when not named, is found beside it. */
+static int check_version(PythonChoice* choice, char* why) {
+    char base_bin[PATH_MAX];
+    int major, minor;
+    inspect_executable(choice->executable, base_bin, &major, &minor);
+    if (major != 0 && (major != PY_MAJOR_VERSION || minor != PY_MINOR_VERSION)) {
+        snprintf(why, WHY_SIZE,
+                 "the FMU was built for Python %d.%d, but %s (from %s) is Python %d.%d; set "
+                 "%s to a Python %d.%d executable",
+                 PY_MAJOR_VERSION, PY_MINOR_VERSION, choice->executable, choice->source, major,
+                 minor, PYTHON_VARIABLE, PY_MAJOR_VERSION, PY_MINOR_VERSION);
+        return 0;
+    }
+    if (choice->library[0] == '\0') library_beside(base_bin, major, minor, choice->library);
+    return 1;
+}
+
+static int choose_python(const char* binaries, PythonChoice* choice, char* why) {
+    memset(choice, 0, sizeof *choice);
+    const char* variable = getenv(PYTHON_VARIABLE);
+    if (variable && variable[0]) {
+        snprintf(choice->executable, PATH_MAX, "%s", variable);
+        snprintf(choice->source, sizeof choice->source, "$%s", PYTHON_VARIABLE);
+        return check_version(choice, why);
+    }
+    char path[PATH_MAX + 64];
+    snprintf(path, sizeof path, "%s/../../resources/%s", binaries, PYTHON_FILE);
+    snprintf(choice->source, sizeof choice->source, "resources/%s", PYTHON_FILE);
+    FILE* f = fopen(path, "r");
+    if (f == NULL) {
+        snprintf(why, WHY_SIZE,
+                 "no Python in this process and no resources/%s to name one; set %s to a "
+                 "Python %d.%d executable",
+                 PYTHON_FILE, PYTHON_VARIABLE, PY_MAJOR_VERSION, PY_MINOR_VERSION);
+        return 0;
+    }
+    char line[PATH_MAX + 32];
+    while (fgets(line, sizeof line, f)) {
+        trim(line);
+        if (strncmp(line, "executable=", 11) == 0)
+            snprintf(choice->executable, PATH_MAX, "%s", line + 11);
+        else if (strncmp(line, "library=", 8) == 0)
+            snprintf(choice->library, PATH_MAX, "%s", line + 8);
+    }
+    fclose(f);
+    if (choice->executable[0] == '\0') {
+        snprintf(why, WHY_SIZE, "resources/%s names no executable; set %s to a Python %d.%d "
+                 "executable", PYTHON_FILE, PYTHON_VARIABLE, PY_MAJOR_VERSION, PY_MINOR_VERSION);
+        return 0;
+    }
+    return check_version(choice, why);
+}
+
+#define PY_FUNCTION(handle, name)                                                               \
+    do {                                                                                        \
+        *(void**)&py.name = dlsym(handle, #name);                                               \
+        if (py.name == NULL) {                                                                  \
+            snprintf(why, WHY_SIZE, "the Python in this process has no %s", #name);             \
+            return 0;                                                                           \
+        }                                                                                       \
+    } while (0)
+
+/* What starting Python takes (a Python host's interpreter is used as it is: only
+ * Py_IsInitialized is asked of it). */
+static int python_functions(void* handle, char* why) {
+    PY_FUNCTION(handle, Py_GetVersion);
+    PY_FUNCTION(handle, PyConfig_InitPythonConfig);
+    PY_FUNCTION(handle, PyConfig_SetBytesString);
+    PY_FUNCTION(handle, Py_InitializeFromConfig);
+    PY_FUNCTION(handle, PyConfig_Clear);
+    PY_FUNCTION(handle, PyStatus_Exception);
+    PY_FUNCTION(handle, PyEval_SaveThread);
+    return 1;
+}
+
+/* Start Python as `choice->executable` would start (its prefix, a virtual environment's
+ * site-packages), without taking over the host's signals; then let go of the GIL. */
+static int start_python(const PythonChoice* choice, char* why) {
+    const char* version = py.Py_GetVersion();
+    int major = 0, minor = 0;
+    if (sscanf(version, "%d.%d", &major, &minor) != 2 || major != PY_MAJOR_VERSION ||
+        minor != PY_MINOR_VERSION) {
+        snprintf(why, WHY_SIZE,
+                 "the FMU was built for Python %d.%d, but the Python to start (%s) is %.20s; "
+                 "set %s to a Python %d.%d executable",
+                 PY_MAJOR_VERSION, PY_MINOR_VERSION, choice->library, version, PYTHON_VARIABLE,
+                 PY_MAJOR_VERSION, PY_MINOR_VERSION);
+        return 0;
+    }
+    if (access(choice->executable, X_OK) != 0) {
+        snprintf(why, WHY_SIZE, "the Python executable %s (from %s) is not there", 
+                 choice->executable, choice->source);
+        return 0;
+    }
+    PyConfig config;
+    py.PyConfig_InitPythonConfig(&config);
+    config.install_signal_handlers = 0;
+    config.parse_argv = 0;
+    PyStatus status =
+        py.PyConfig_SetBytesString(&config, &config.program_name, choice->executable);
+    if (!py.PyStatus_Exception(status)) status = py.Py_InitializeFromConfig(&config);
+    py.PyConfig_Clear(&config);
+    if (py.PyStatus_Exception(status)) {
+        snprintf(why, WHY_SIZE, "cannot start Python %s (from %s): %s%s%s", choice->executable,
+                 choice->source, status.func ? status.func : "",
+                 status.func ? ": " : "", status.err_msg ? status.err_msg : "failed");
+        return 0;
+    }
+    py.PyEval_SaveThread(); /* the runtime takes the GIL for each call, from any thread */
+    return 1;
+}
+
+/* Make sure the process has a running Python whose symbols the runtime can see. */
+static int python_ready(const char* binaries, char* why) {
+    void* handle = RTLD_DEFAULT;
+    PythonChoice choice;
+    int chosen = 0;
+    if (dlsym(RTLD_DEFAULT, "Py_IsInitialized") == NULL) {
+        /* A libpython some other part of the process loaded privately: make it global. */
+        char loaded[PATH_MAX] = "";
+        dl_iterate_phdr(find_libpython, loaded);
+        if (loaded[0]) {
+            handle = dlopen(loaded, RTLD_NOW | RTLD_NOLOAD | RTLD_GLOBAL);
+        } else {
+            if (!choose_python(binaries, &choice, why)) return 0;
+            chosen = 1;
+            handle = dlopen(choice.library, RTLD_NOW | RTLD_GLOBAL);
+            if (handle == NULL) {
+                snprintf(why, WHY_SIZE,
+                         "no Python in this process and cannot load %s (from %s): %s; set %s "
+                         "to a Python %d.%d executable",
+                         choice.library, choice.source, dlerror(), PYTHON_VARIABLE,
+                         PY_MAJOR_VERSION, PY_MINOR_VERSION);
+                return 0;
+            }
+        }
+        if (handle == NULL) {
+            snprintf(why, WHY_SIZE, "cannot use the libpython %s of this process: %s", loaded,
+                     dlerror());
+            return 0;
+        }
+    }
+    PY_FUNCTION(handle, Py_IsInitialized);
+    if (py.Py_IsInitialized()) return 1; /* a Python host: its interpreter, as it is */
+    if (!python_functions(handle, why)) return 0;
+    if (!chosen && !choose_python(binaries, &choice, why)) return 0;
+    return start_python(&choice, why);
+}
+
+/* -- the runtime ---------------------------------------------------------------------------- */
+/* Registered after the runtime's static constructors, so run at exit before its static
+ * destructors: the runtime's own library destructor would otherwise reset its interpreter
+ * state once those have freed it (heap corruption at exit). */
+static void release_runtime(void) {
+    if (runtime.finalizePythonInterpreter) runtime.finalizePythonInterpreter();
+}
+
+#define RUNTIME_FUNCTION(name)                                                                  \
+    do {                                                                                        \
+        *(void**)&runtime.name = dlsym(handle, #name);                                          \
+        if (runtime.name == NULL) {                                                             \
+            snprintf(why, WHY_SIZE, "pythonfmu's runtime %s has no %s", path, #name);          \
+            return 0;                                                                           \
+        }                                                                                       \
+    } while (0)
+#define RESOLVE(name, params, args) RUNTIME_FUNCTION(name);
+
+static int load_runtime(const char* binaries, char* why) {
+    char path[PATH_MAX + 64];
+    snprintf(path, sizeof path, "%s/%s", binaries, RUNTIME_FILE);
+    void* handle = dlopen(path, RTLD_NOW | RTLD_LOCAL);
+    if (handle == NULL) {
+        snprintf(why, WHY_SIZE, "cannot load pythonfmu's runtime: %s", dlerror());
+        return 0;
+    }
+    RUNTIME_FUNCTION(fmi2Instantiate);
+    RUNTIME_FUNCTION(fmi2FreeInstance);
+    INSTANCE_FUNCTIONS(RESOLVE)
+    *(void**)&runtime.finalizePythonInterpreter = dlsym(handle, "finalizePythonInterpreter");
+    /* The runtime is never unloaded (pythonfmu's runtime does not survive it), so neither is
+     * this loader, which holds its entry points: a host that unloads and loads the FMU again
+     * finds both as they were. */
+    Dl_info info;
+    if (dladdr((void*)&load_runtime, &info) && info.dli_fname)
+        dlopen(info.dli_fname, RTLD_NOW | RTLD_NOLOAD | RTLD_NODELETE);
+    atexit(release_runtime);
+    runtime.handle = handle;
+    return 1;
+}
+
+static int prepare(char* why) {
+    char binaries[PATH_MAX];
+    pthread_mutex_lock(&prepare_lock);
+    int ok = runtime.handle != NULL ||
+             (own_directory(binaries, sizeof binaries, why) && python_ready(binaries, why) &&
+              load_runtime(binaries, why));
+    pthread_mutex_unlock(&prepare_lock);
+    return ok;
+}
+
+/* -- FMI 2.0 ---------------------------------------------------------------------------------- */
+EXPORT const char* fmi2GetTypesPlatform(void) { return "default"; }
+
+EXPORT const char* fmi2GetVersion(void) { return "2.0"; }
+
+static void free_categories(Instance* i) {
+    for (size_t k = 0; k < i->n_categories; ++k) free(i->categories[k]);
+    free(i->categories);
+    i->categories = NULL;
+    i->n_categories = 0;
+}
+
+static void free_instance(Instance* i) {
+    free_categories(i);
+    free(i->name);
+    free(i);
+}
+
+EXPORT fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2String fmuGUID,
+                                     fmi2String fmuResourceLocation,
+                                     const fmi2CallbackFunctions* functions, fmi2Boolean visible,
+                                     fmi2Boolean loggingOn) {
+    char why[WHY_SIZE];
+    const char* name = instanceName ? instanceName : "";
+    if (!prepare(why)) {
+        emit(functions, name, fmi2Error, "logStatusError", why);
+        return NULL;
+    }
+    Instance* i = calloc(1, sizeof *i);
+    if (i == NULL || (i->name = strdup(name)) == NULL) {
+        free(i);
+        emit(functions, name, fmi2Error, "logStatusError", "out of memory");
+        return NULL;
+    }
+    if (functions) i->host = *functions;
+    i->relayed = i->host;
+    i->relayed.logger = relay;
+    i->relayed.componentEnvironment = i;
+    i->debug = loggingOn;
+    /* The runtime cannot do without the resource location: where a host gives none, the
+     * FMU's own resources/ beside binaries/ is meant. */
+    char resources[PATH_MAX + 32];
+    if (fmuResourceLocation == NULL || fmuResourceLocation[0] == '\0') {
+        char binaries[PATH_MAX];
+        if (!own_directory(binaries, sizeof binaries, why)) {
+            emit(functions, name, fmi2Error, "logStatusError", why);
+            free_instance(i);
+            return NULL;
+        }
+        snprintf(resources, sizeof resources, "file://%s/../../resources", binaries);
+        fmuResourceLocation = resources;
+    }
+    /* The runtime logs with debug logging on, always: relay() does the filtering. */
+    i->inner = runtime.fmi2Instantiate(instanceName, fmuType, fmuGUID, fmuResourceLocation,
+                                       &i->relayed, visible, 1);
+    if (i->inner == NULL) { /* the runtime has logged why */
+        free_instance(i);
+        return NULL;
+    }
+    return i;
+}
+
+EXPORT void fmi2FreeInstance(fmi2Component c) {
+    Instance* i = c;
+    if (i == NULL) return;
+    if (!i->failed) runtime.fmi2FreeInstance(i->inner);
+    free_instance(i);
+}
+
+static int usable(Instance* i, const char* function) {
+    if (i == NULL) return 0;
+    if (i->failed) {
+        char why[256];
+        snprintf(why, sizeof why, "%s: the instance failed fatally before; only "
+                 "fmi2FreeInstance may be called", function);
+        emit(&i->host, i->name, fmi2Error, "logStatusError", why);
+        return 0;
+    }
+    return 1;
+}
+
+EXPORT fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, size_t nCategories,
+                                      const fmi2String categories[]) {
+    Instance* i = c;
+    if (!usable(i, "fmi2SetDebugLogging")) return fmi2Error;
+    free_categories(i);
+    if (nCategories > 0 && categories) {
+        i->categories = calloc(nCategories, sizeof *i->categories);
+        if (i->categories == NULL) return fmi2Error;
+        for (size_t k = 0; k < nCategories; ++k) {
+            i->categories[k] = strdup(categories[k] ? categories[k] : "");
+            if (i->categories[k] == NULL) return fmi2Error;
+            i->n_categories = k + 1;
+        }
+    }
+    i->debug = loggingOn;
+    return fmi2OK;
+}
+
+#define FORWARD(name, params, args)                                                             \
+    EXPORT fmi2Status name params {                                                             \
+        Instance* i = c;                                                                        \
+        if (!usable(i, #name)) return fmi2Error;                                                \
+        fmi2Status status = runtime.name args;                                                  \
+        if (status == fmi2Fatal) i->failed = 1;                                                 \
+        return status;                                                                          \
+    }
+INSTANCE_FUNCTIONS(FORWARD)
