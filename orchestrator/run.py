@@ -34,6 +34,7 @@ from orchestrator.recorder import Recorder, StepStats
 from orchestrator.scenario import Scene
 from orchestrator.scenes import ANALYSES, PLOTS, REFERENCES
 from orchestrator.scenes.family import Reference
+from orchestrator.signals import scene_signals
 from orchestrator.system import CoupledSystem
 
 
@@ -288,7 +289,9 @@ def _versions() -> dict[str, str | None]:
 
 def _metadata(scene: Scene, fmu_paths: dict[str, Path]) -> dict[str, Any]:
     versions = dict(_versions())
+    signals = scene_signals(scene)
     return {
+        **({"signals": signals.provenance()} if signals else {}),  # a CSV file's sha256
         "scene_file": str(scene.path),
         "scene_sha256": file_sha256(scene.path),
         "fmus": {

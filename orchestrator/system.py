@@ -13,6 +13,7 @@ from typing import Any
 from orchestrator.errors import RunError
 from orchestrator.fmu_instance import FmuInstance
 from orchestrator.scenario import Scene
+from orchestrator.signals import scene_signals
 
 
 @dataclass
@@ -108,6 +109,11 @@ class CoupledSystem:
         self.values: list[list[float]] = [[] for _ in self.names]
         self.ints: list[list[int]] = [[] for _ in self.names]
         self.record_header = [f"{inst}.{var}" for inst, var in scene.record]
+        #: inputs that vary in time: fed around every doStep; masters land on breakpoints
+        self.signals = scene_signals(scene)
+        self.signals.bind(
+            self.names, lambda n, v: self.instance(n).setter(self.instance(n).refs(v))
+        )
 
     def _slot(self, i: int, var: str) -> tuple[str, int]:
         kind = "int" if self.instances[i].is_integer(var) else "real"
@@ -175,7 +181,13 @@ class CoupledSystem:
             set_ints([ints[s][k] for s, k in feed.int_sources])
 
     def step(self, i: int, t: float, h: float) -> None:
-        self.instances[i].do_step(t, h)
+        signals = self.signals
+        if signals:  # the value at the step start; after the step, the value at its end
+            signals.apply(i, t)
+            self.instances[i].do_step(t, h)
+            signals.apply(i, t + h)
+        else:
+            self.instances[i].do_step(t, h)
 
     def record_row(self, t: float) -> list[float]:
         row = [t]

@@ -39,8 +39,12 @@ def run_fixed_step(
     recorder.row(system.record_row(start))
     log = RegimeLog(system, recorder)
     t = start
-    for k in range(n):
-        hk = h if k < n - 1 else stop - t
+    k = 0  # grid steps done
+    while k < n:
+        grid = start + (k + 1) * h if k < n - 1 else stop
+        t_end = system.signals.land(t, grid)  # an input signal's jump or kink ends a step
+        on_grid = grid - t_end <= 1e-9 * h
+        hk = t_end - t if system.signals else (h if k < n - 1 else stop - t)
         if sequential:  # Gauss–Seidel: each FMU sees the newest outputs
             for i in range(m):
                 system.feed(i)
@@ -51,13 +55,14 @@ def run_fixed_step(
                 system.feed(i)
                 system.step(i, t, hk)
             system.read_all()
-        t = start + (k + 1) * h if k < n - 1 else stop
+        t = t_end
+        k += on_grid
         stats.steps += 1
         stats.do_steps += m
         stats.events += log.update(t)
         stop_indicator = system.stop_indicator()
         done = stop_indicator is not None and stop_indicator <= 0.0
-        if (k + 1) % every == 0 or k == n - 1 or done:
+        if k % every == 0 or k == n or done or not on_grid:
             recorder.row(system.record_row(t))
         progress(t)
         if done:  # a fixed-step master stops at the first step past the condition

@@ -225,8 +225,8 @@ class RegimeAwareMaster:
         """
         system = self.system
         after_regimes, after_ind = system.regimes(), system.indicators()
-        best: float | None = None
-        reported: float | None = None  # the earliest instant an FMU reported
+        # An input signal's jump where the step ends is a known, located switch.
+        best = reported = t + h if system.signals.jump_at(t + h) else None
         g1 = system.stop_indicator()
         if g1 is not None and g1 <= 0.0 < before.stop:
             best = t + h * before.stop / (before.stop - g1)
@@ -305,7 +305,7 @@ class RegimeAwareMaster:
         recorder.row(system.record_row(t))
         same_instant = 0
         while t < stop - control.stop_slack * max(1.0, abs(stop)):
-            h = min(h, stop - t)
+            h = system.signals.clip(t, min(h, stop - t))  # ends on an input's breakpoint
             state = system.get_state()
             before = self.snapshot()  # consistent: every trial and settle ends refreshed
             try:
