@@ -538,3 +538,64 @@ def scene_signals(scene: Any) -> InputSignals:
             for name, signal in getattr(spec, "signals", {}).items()
         }
     )
+
+
+# -- export ---------------------------------------------------------------------------
+def refuse_signals(scene: Any, fmt: str, why: str) -> None:
+    """A format that cannot carry inputs that vary in time refuses the scene, in one line
+    naming the first such input."""
+    signals = scene_signals(scene)
+    if signals:
+        instance, name = next(iter(signals.driven))
+        raise ScenarioError(
+            scene.path, f"fmus.{instance}.inputs.{name}", f"a signal drives it: {fmt} {why}"
+        )
+
+
+def libcosim_scenario(scene: Any, step: float) -> dict[str, Any] | None:
+    """The scene's signals as a libcosim scenario (JSON: events that override an input's
+    value from a given time on, timed from the start), or None without signals.
+
+    A libcosim scenario sets values at instants, and its fixed-step algorithm takes them
+    at its communication points: a signal with a slope, or a jump off the base step's
+    grid, cannot be carried and is refused naming it.
+    """
+    signals = scene_signals(scene)
+    if not signals:
+        return None
+    events = []
+    for (instance, name), signal in signals.driven.items():
+        key = f"fmus.{instance}.inputs.{name}"
+        if signal.breakpoints() != signal.jumps:
+            raise ScenarioError(
+                scene.path,
+                key,
+                "a signal with a slope cannot be written as libcosim scenario events "
+                '(they set a value at an instant); use interpolation = "hold"',
+            )
+        for t in signal.jumps:
+            if not scene.start <= t < scene.stop:
+                continue  # before the start: in the initial value; after the stop: unused
+            k = (t - scene.start) / step
+            if abs(k - round(k)) > 1e-6:
+                raise ScenarioError(
+                    scene.path,
+                    key,
+                    f"its jump at {t:g} s is not on libcosim's base step grid "
+                    f"({step:g} s from {scene.start:g} s): libcosim would take it late",
+                )
+            events.append(
+                {
+                    "time": round(k) * step,
+                    "model": instance,
+                    "variable": name,
+                    "action": "override",
+                    "value": signal.value(t),
+                }
+            )
+    events.sort(key=lambda e: e["time"])
+    return {
+        "description": f"input signals of scene {scene.name!r}, times from the start",
+        "events": events,
+        "end": scene.stop - scene.start,
+    }

@@ -329,3 +329,53 @@ def test_values_outside_the_inputs_range_are_refused_with_the_row(tmp_path: Path
     integer = VariableInfo("n", 2, "input", "discrete", "Integer", None, "0", None, None, "")
     with pytest.raises(ScenarioError, match="drives a Real input"):
         read_signal(reader, {"step": 0.0, "from": 0, "to": 1}, "k", integer, (0.0, 1.0))
+
+
+# -- export --------------------------------------------------------------------------
+def test_osp_export_carries_a_held_signal_that_libcosim_runs_as_we_do(tmp_path: Path) -> None:
+    """The jumps become libcosim scenario events; libcosim's fixed-step run of the exported
+    system gives the speeds of our Jacobi run to round-off."""
+    import json
+
+    from libcosimpy.CosimExecution import CosimExecution
+    from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
+    from libcosimpy.CosimManipulator import CosimManipulator
+    from libcosimpy.CosimObserver import CosimObserver
+
+    from orchestrator.osp_export import SCENARIO_FILE, export_osp
+
+    table = '[["0 s", 0.0], ["2 ms", 0.0], ["2 ms", "1 N*m"], ["6 ms", "1 N*m"], ["6 ms", -0.5]]'
+    path = write(tmp_path, scene_text(f'{{ table = {table}, interpolation = "hold" }}'))
+    ours = run(tmp_path, path)
+    xml = export_osp(load_scene(path), tmp_path / "osp")
+    scenario = json.loads((xml.parent / SCENARIO_FILE).read_text())
+    assert [(e["time"], e["value"]) for e in scenario["events"]] == [(0.002, 1.0), (0.006, -0.5)]
+
+    log_output_level(CosimLogLevel.ERROR)
+    execution = CosimExecution.from_osp_config_file(str(xml))
+    observer = CosimObserver.create_last_value()
+    execution.add_observer(observer)
+    manager = CosimManipulator.create_scenario_manager()
+    assert execution.add_manipulator(manager)
+    assert execution.load_scenario(manager, str(xml.parent / SCENARIO_FILE))
+    (slave,) = execution.slave_infos()
+    ref = {v.name.decode(): v.reference for v in execution.slave_variables(slave.index)}["w"]
+    theirs = []
+    for _ in range(10):
+        assert execution.step(1)
+        theirs.append(observer.last_real_values(slave.index, [ref])[0])
+    np.testing.assert_allclose(theirs, ours.signal("a.w")[1:], rtol=1e-12, atol=1e-12)
+
+
+def test_exports_refuse_what_they_cannot_carry(tmp_path: Path) -> None:
+    from orchestrator.osp_export import export_osp
+    from orchestrator.ssp_export import export_ssp
+
+    path = write(tmp_path, scene_text('{ ramp = ["0 s", "1 ms"], from = 0.0, to = 1.0 }'))
+    with pytest.raises(ScenarioError, match=r"\[fmus.a.inputs.tau\] a signal with a slope"):
+        export_osp(load_scene(path), tmp_path / "osp")
+    with pytest.raises(ScenarioError, match=r"\[fmus.a.inputs.tau\] a signal drives it: SSP"):
+        export_ssp(load_scene(path), tmp_path / "x.ssp")
+    path = write(tmp_path, scene_text('{ step = "1.5 ms", from = 0.0, to = 1.0 }'))
+    with pytest.raises(ScenarioError, match=r"1.5 ms|0.0015 s is not on libcosim's base step"):
+        export_osp(load_scene(path), tmp_path / "osp")
