@@ -160,3 +160,32 @@ def test_a_set_point_beyond_the_inputs_range_is_refused(controller: Path, tmp_pa
         ScenarioError, match=r"\[fmus.c.inputs.u_s.table\[1\]\] 200 rad/s is outside"
     ):
         load_scene(path)
+
+
+def test_crosscheck_gives_fmpy_simulate_fmu_the_same_input(controller: Path, tmp_path: Path):
+    """``mechcosim crosscheck`` runs a one-FMU scene with held signals through FMPy's
+    simulate_fmu with the signals as its input table, and libcosim (--via osp) with them
+    as a scenario file where every jump is on its grid."""
+    from orchestrator.cli import main
+    from orchestrator.studies.crosscheck import crosscheck
+
+    table = '{ table = [[0, 0], ["1.5 ms", 0], ["1.5 ms", 1], ["6 ms", 1], ["6 ms", -0.5]] }'
+    path = scene(tmp_path, controller, table)
+    check = crosscheck(path, tools=("fmpy",))
+    (outcome,) = check.outcomes
+    assert outcome.cannot_run is None and outcome.run.via == "simulate_fmu with the input signals"
+    assert outcome.agreement.points == 9  # not at the jump at 6 ms (FMPy: values before it)
+    assert outcome.agreement.worst[1] <= 1e-12, outcome.agreement.per_signal
+    assert main(["crosscheck", str(path), "--tool", "fmpy"]) == 0
+
+    check = crosscheck(path, tools=("libcosim",), via="osp")  # the jump at 1.5 ms is off grid
+    assert "not on libcosim's base step grid" in check.outcomes[0].cannot_run
+    path = scene(tmp_path, controller, '{ step = "2 ms", from = 0, to = 1 }')
+    check = crosscheck(path, tools=("libcosim", "fmpy"), via="osp")
+    assert all(o.agreement.worst[1] <= 1e-12 for o in check.outcomes), check.outcomes
+    # Neither tool shows the values after the jump at its instant (2 ms): 9 of 10 points.
+    assert [o.agreement.points for o in check.outcomes] == [9, 9]
+
+    path = scene(tmp_path, controller, '{ step = "0 s", from = 0, to = 1 }')
+    check = crosscheck(path, tools=("fmpy",))
+    assert "holds a table's first value over the first step" in check.outcomes[0].cannot_run
