@@ -114,6 +114,7 @@ class CoupledSystem:
         self.signals.bind(
             self.names, lambda n, v: self.instance(n).setter(self.instance(n).refs(v))
         )
+        self._drive = self.signals.apply if self.signals else None  # hot path: no call
 
     def _slot(self, i: int, var: str) -> tuple[str, int]:
         kind = "int" if self.instances[i].is_integer(var) else "real"
@@ -181,13 +182,13 @@ class CoupledSystem:
             set_ints([ints[s][k] for s, k in feed.int_sources])
 
     def step(self, i: int, t: float, h: float) -> None:
-        signals = self.signals
-        if signals:  # the value at the step start; after the step, the value at its end
-            signals.apply(i, t)
+        drive = self._drive
+        if drive is None:
             self.instances[i].do_step(t, h)
-            signals.apply(i, t + h)
-        else:
+        else:  # the signals' values at the step start; after the step, at its end
+            drive(i, t)
             self.instances[i].do_step(t, h)
+            drive(i, t + h)
 
     def record_row(self, t: float) -> list[float]:
         row = [t]

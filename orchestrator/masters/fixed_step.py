@@ -39,12 +39,13 @@ def run_fixed_step(
     recorder.row(system.record_row(start))
     log = RegimeLog(system, recorder)
     t = start
+    signals = system.signals if system.signals else None
     k = 0  # grid steps done
     while k < n:
         grid = start + (k + 1) * h if k < n - 1 else stop
-        t_end = system.signals.land(t, grid)  # an input signal's jump or kink ends a step
-        on_grid = grid - t_end <= 1e-9 * h
-        hk = t_end - t if system.signals else (h if k < n - 1 else stop - t)
+        t_end = grid if signals is None else signals.land(t, grid)  # a signal's breakpoint
+        on_grid = grid - t_end <= 1e-9 * h  # ends a step too
+        hk = (h if k < n - 1 else stop - t) if signals is None else t_end - t
         if sequential:  # Gauss–Seidel: each FMU sees the newest outputs
             for i in range(m):
                 system.feed(i)
