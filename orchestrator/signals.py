@@ -129,6 +129,11 @@ class Signal:
         return sorted(self._jumps)
 
     @property
+    def scale(self) -> float:
+        """The largest magnitude the signal takes."""
+        return max(abs(v) for v in self.values)
+
+    @property
     def span(self) -> tuple[float, float]:
         return self.times[0], self.times[-1]
 
@@ -501,10 +506,18 @@ class InputSignals:
             return nxt
         return end
 
-    def clip(self, t: float, h: float) -> float:
-        """The step from t: h, or shorter to end on the next breakpoint."""
+    def clip(self, t: float, h: float, tolerance: float | None = None) -> float:
+        """The step from t: h, or shorter to end on the next breakpoint; with a
+        ``tolerance``, also short enough that no sloped signal, held at its step-start
+        value, changes by more than ``tolerance`` times its largest magnitude over the step
+        (the first-order hold error an error-controlled master must see)."""
         if not self._breaks:
             return h
+        if tolerance is not None:
+            for s in self.signals:
+                slope = abs(s.slope(t))
+                if slope > 0.0:
+                    h = min(h, tolerance * s.scale / slope)
         end = self.land(t, t + h)
         return h if end == t + h else end - t
 

@@ -305,7 +305,8 @@ class RegimeAwareMaster:
         recorder.row(system.record_row(t))
         same_instant = 0
         while t < stop - control.stop_slack * max(1.0, abs(stop)):
-            h = system.signals.clip(t, min(h, stop - t))  # ends on an input's breakpoint
+            # Ends on an input signal's breakpoint; its hold error within the tolerance.
+            h = system.signals.clip(t, min(h, stop - t), cfg.tolerance)
             state = system.get_state()
             before = self.snapshot()  # consistent: every trial and settle ends refreshed
             try:

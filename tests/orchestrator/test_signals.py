@@ -145,12 +145,15 @@ def test_ramp_kinks_are_landed_on_and_the_hold_is_first_order(tmp_path: Path, al
     """A ramp from 0.3 ms to 4.3 ms (off the grid) passed as the value at each step start:
     every master ends a step on both kinks, and the speed at the ramp's end is the closed
     form less slope / (2 J) * sum of the squared steps over the ramp (the zero-order hold's
-    deficit, exactly); halving the step about halves it."""
+    deficit, exactly); halving the step about halves it.  The regime-aware master keeps
+    the held value's change per step within its tolerance (1e-3 of the peak torque): the
+    deficit is then 1e-3 of the speed gained over the ramp."""
     path = write(tmp_path, scene_text('{ ramp = ["0.3 ms", "4.3 ms"], from = 0.0, to = "2 N*m" }'))
     slope, duration = 2.0 / 4e-3, 4e-3
     deficits = []
     for h in (0.5e-3, 0.25e-3):
-        result = run(tmp_path, path, **{"master.algorithm": algorithm, "master.step": h})
+        overrides = {"master.algorithm": algorithm, "master.step": h, "master.tolerance": 1e-3}
+        result = run(tmp_path, path, **overrides)
         t = result.signal("time")
         w = result.signal("a.w")
         on = [
@@ -164,8 +167,11 @@ def test_ramp_kinks_are_landed_on_and_the_hold_is_first_order(tmp_path: Path, al
         deficits.append(exact - w[end])
         # After the ramp, the torque of 2 N m is held: exact from there on.
         assert w[-1] - w[end] == pytest.approx(2.0 * (10e-3 - t[end]) / J, rel=1e-12)
-    if algorithm != "regime-aware":  # its steps are its own
+    if algorithm != "regime-aware":
         assert 1.8 < deficits[0] / deficits[1] < 2.0
+    else:  # steps short enough that the held torque changes by at most 1e-3 of its peak
+        assert max(deficits) <= 1e-3 * (2.0 * duration / (2 * J)) * (1 + 1e-9)
+        assert max(deficits) > 0.9e-3 * (2.0 * duration / (2 * J))
 
 
 def test_step_shorthand_and_csv_file(tmp_path: Path) -> None:
