@@ -380,7 +380,11 @@ def _csv(reader: Reader, raw: dict[str, Any], key: str, var: Any):
     except OSError as exc:
         raise reader.fail(fkey, f"cannot read {path}: {exc.strerror or exc}") from None
     try:
-        lines = list(csv.reader(data.decode("utf-8-sig").splitlines()))
+        text_lines = data.decode("utf-8-sig").splitlines()
+        header = text_lines[0] if text_lines else ""
+        # Comma, or what a spreadsheet writes where the comma is the decimal mark.
+        delimiter = next((d for d in ",;\t" if d in header), ",")
+        lines = list(csv.reader(text_lines, delimiter=delimiter))
     except (UnicodeDecodeError, csv.Error) as exc:
         raise ScenarioError(path, fkey, f"not a UTF-8 CSV file ({exc})") from None
     if not lines or not any(cell.strip() for cell in lines[0]):

@@ -194,6 +194,10 @@ def test_step_shorthand_and_csv_file(tmp_path: Path) -> None:
     assert result.signal("a.w")[k] == pytest.approx(held / J, rel=1e-12)
     assert result.signal("a.w")[-1] == pytest.approx((held - 0.25 * 8e-3) / J, rel=1e-12)
 
+    (tmp_path / "semicolons.csv").write_text("time [ms];tau [N*mm]\n0;0\n2;500\n")
+    path = write(tmp_path, scene_text('{ file = "semicolons.csv" }'), "semi.toml")
+    assert load_scene(path).fmus["a"].signals["tau"].values == (0.0, 0.5)
+
     step = write(tmp_path, scene_text('{ step = "2.5 ms", from = "1 N*m", to = 0.0 }'), "s.toml")
     result = run(tmp_path, step, **{"master.algorithm": "gauss-seidel"})
     assert 2.5e-3 in result.signal("time").tolist()
