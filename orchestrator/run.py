@@ -216,7 +216,12 @@ def _analyse(
         quantities.update(headline(scene, header, data))
     with _noted(notes, "energy residual", header):
         residual = energy_residual(header, data)
-        if residual is not None:
+        if residual is not None and scene_signals(scene):
+            notes.append(  # e.g. a torque table into an Inertia: all its energy came in so
+                "energy residual not computed: input signals do work on the FMUs, which "
+                "they do not report apart from the work through their connections"
+            )
+        elif residual is not None:
             quantities["energy_residual"] = residual
     if scene.analysis and status == "completed":
         with _noted(notes, f"analysis {scene.analysis!r}", header):

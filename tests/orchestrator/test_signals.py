@@ -216,6 +216,9 @@ def test_provenance_names_the_csv_file_and_its_hash(tmp_path: Path) -> None:
     assert entry["sha256"] == hashlib.sha256(csv_text.encode()).hexdigest()
     assert entry["file"] == str(tmp_path / "t.csv") and entry["form"] == "file"
     assert result.metadata["signals"] == summary["metadata"]["signals"]
+    # The torque the table applies does work the FMU does not report apart: no residual.
+    assert "energy_residual" not in summary["headline"]
+    assert any("input signals do work" in note for note in summary["notes"])
 
 
 def test_the_step_height_is_a_sweep_key(tmp_path: Path) -> None:
