@@ -50,6 +50,15 @@ def _snap_tolerance(t: float) -> float:
     return SNAP * max(1.0, abs(t))
 
 
+def _snap(breaks: list[float], t: float) -> float:
+    """``t``, or the breakpoint in ``breaks`` (sorted) it is within rounding of."""
+    k = bisect.bisect_left(breaks, t)
+    for j in (k - 1, k):
+        if 0 <= j < len(breaks) and abs(breaks[j] - t) <= _snap_tolerance(t):
+            return breaks[j]
+    return t
+
+
 @dataclass(frozen=True)
 class Signal:
     """A table of (time, value) rows in SI, with its interpolation and its origin."""
@@ -71,12 +80,7 @@ class Signal:
     # -- values -----------------------------------------------------------------------
     def snap(self, t: float) -> float:
         """``t``, or the breakpoint it is within floating-point rounding of."""
-        breaks = self._breaks
-        k = bisect.bisect_left(breaks, t)
-        for j in (k - 1, k):
-            if 0 <= j < len(breaks) and abs(breaks[j] - t) <= _snap_tolerance(t):
-                return breaks[j]
-        return t
+        return _snap(self._breaks, t)
 
     def value(self, t: float, left: bool = False) -> float:
         """The value at t (at a jump, the value after it; ``left``: the value before)."""
@@ -464,6 +468,7 @@ class InputSignals:
         times = sorted({t for s in self.signals for t in s.breakpoints()})
         self._breaks = times
         self._jumps = sorted({t for s in self.signals for t in s.jumps})
+        self._jump_set = frozenset(self._jumps)
         self._setters: list[tuple[Callable[[list], None], list[Signal]] | None] = []
 
     def __bool__(self) -> bool:
@@ -487,17 +492,9 @@ class InputSignals:
             set_values, signals = bound
             set_values([s.value(t) for s in signals])
 
-    def snap(self, t: float) -> float:
-        breaks = self._breaks
-        k = bisect.bisect_left(breaks, t)
-        for j in (k - 1, k):
-            if 0 <= j < len(breaks) and abs(breaks[j] - t) <= _snap_tolerance(t):
-                return breaks[j]
-        return t
-
     def next_breakpoint(self, t: float) -> float | None:
         """The first jump or kink of any signal later than t."""
-        k = bisect.bisect_right(self._breaks, self.snap(t))
+        k = bisect.bisect_right(self._breaks, _snap(self._breaks, t))
         return self._breaks[k] if k < len(self._breaks) else None
 
     def land(self, t: float, end: float) -> float:
@@ -527,10 +524,7 @@ class InputSignals:
 
     def jump_at(self, t: float) -> bool:
         """Whether some signal jumps at t (within rounding)."""
-        if not self._jumps:
-            return False
-        k = bisect.bisect_left(self._jumps, t - _snap_tolerance(t))
-        return k < len(self._jumps) and abs(self._jumps[k] - t) <= _snap_tolerance(t)
+        return bool(self._jumps) and _snap(self._jumps, t) in self._jump_set
 
     def provenance(self) -> dict[str, Any]:
         """Per driven input, how the scene gave it (a CSV file with its sha256)."""
