@@ -305,10 +305,10 @@ def _export(args: argparse.Namespace) -> int:
         print(f"error: --osp {args.osp}: is a file; expected a directory", file=sys.stderr)
         return 2
     scene = load_scene(args.scene, _overrides(args.set))
+    if args.osp is not None:  # first: it carries input signals, which SSP refuses
+        print(f"{export_osp(scene, args.osp)}: the FMUs beside it")
     out = export_ssp(scene, args.out)
     print(f"{out}: {len(scene.fmus)} components, {len(scene.connections)} connections")
-    if args.osp is not None:
-        print(f"{export_osp(scene, args.osp)}: the FMUs beside it")
     return 0
 
 

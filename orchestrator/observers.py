@@ -64,7 +64,7 @@ class TimeSeries:
 
     def step(self, count: int, step: MacroStep, last: bool) -> None:
         """After the ``count``-th step (from 1); ``last``: the run ends with it."""
-        if count % self.every == 0 or last:
+        if count % self.every == 0 or last or step.record:
             if step.left_row is not None:
                 self.recorder.row(step.left_row)
             self.recorder.row(self.system.record_row(step.end))

@@ -12,6 +12,7 @@ every value in the FMU's own unit and runs as long as it is told.
 
 from __future__ import annotations
 
+import json
 import os
 import shutil
 import tempfile
@@ -20,10 +21,12 @@ from pathlib import Path
 
 from orchestrator.run import fmu_files
 from orchestrator.scenario import Scene
+from orchestrator.signals import libcosim_scenario
 from orchestrator.ssp_export import libcosim_step
 
 OSP_IS = "http://opensimulationplatform.com/MSMI/OSPSystemStructure"
 FILE_NAME = "OspSystemStructure.xml"
+SCENARIO_FILE = "scenario.json"  # the scene's input signals, when it has some
 ET.register_namespace("", OSP_IS)
 
 
@@ -69,7 +72,10 @@ def export_osp(scene: Scene, out_dir: Path, cache_dir: Path | None = None) -> Pa
     """Write ``out_dir/OspSystemStructure.xml`` and one FMU per instance beside it
     (``<instance>.fmu``); return the XML file's path."""
     out_dir = Path(out_dir)
+    scenario = libcosim_scenario(scene, scene.master.step)  # refuses what it cannot carry
     out_dir.mkdir(parents=True, exist_ok=True)
+    if scenario is not None:
+        (out_dir / SCENARIO_FILE).write_text(json.dumps(scenario, indent=2))
     paths = fmu_files(scene, cache_dir)
     # One file per instance: two instances of one FMU may carry different builds.
     sources = {name: f"{name}.fmu" for name in scene.fmus}

@@ -35,6 +35,7 @@ from orchestrator.recorder import Recorder, StepStats
 from orchestrator.scenario import Scene
 from orchestrator.scenes import ANALYSES, PLOTS, REFERENCES
 from orchestrator.scenes.family import Reference
+from orchestrator.signals import scene_signals
 from orchestrator.system import CoupledSystem
 
 
@@ -215,7 +216,12 @@ def _analyse(
         # Over every step taken (the record may be thinned); a failed run's from what it
         # recorded, the values that failed it included.
         residual = energy.residual() if status != "failed" else energy_residual(header, data)
-        if residual is not None:
+        if residual is not None and scene_signals(scene):
+            notes.append(  # e.g. a torque table into an Inertia: all its energy came in so
+                "energy residual not computed: input signals do work on the FMUs, which "
+                "they do not report apart from the work through their connections"
+            )
+        elif residual is not None:
             quantities["energy_residual"] = residual
     if scene.analysis and status == "completed":
         with _noted(notes, f"analysis {scene.analysis!r}", header):
@@ -288,7 +294,9 @@ def _versions() -> dict[str, str | None]:
 
 def _metadata(scene: Scene, fmu_paths: dict[str, Path]) -> dict[str, Any]:
     versions = dict(_versions())
+    signals = scene_signals(scene)
     return {
+        **({"signals": signals.provenance()} if signals else {}),  # a CSV file's sha256
         "scene_file": str(scene.path),
         "scene_sha256": file_sha256(scene.path),
         "fmus": {

@@ -29,6 +29,14 @@ from orchestrator.master_settings import (
 from orchestrator.model_info import ModelInfo, ModelInfoError, VariableInfo, model_info
 from orchestrator.scenes import ANALYSES, REFERENCES, family
 from orchestrator.scenes.family import Option
+from orchestrator.signals import (
+    Reader,
+    Signal,
+    is_signal,
+    merge_signal_overrides,
+    read_signal,
+    split_signal_key,
+)
 from orchestrator.studies.study_table import StudySpec, parse_study
 from orchestrator.units import to_si
 
@@ -54,6 +62,7 @@ class FmuSpec:
     parameters: dict[str, Any]  # SI values (int for Integer, bool for Boolean)
     inputs: dict[str, Any]  # start values of inputs
     component: str | None = None  # name in fmus.registry when the scene names one of ours
+    signals: dict[str, Signal] = field(default_factory=dict)  # inputs that vary in time
 
 
 @dataclass(frozen=True)
@@ -226,6 +235,7 @@ class _Loader:
         self, path: Path, raw: dict[str, Any], cache_dir: Path | None, force: bool = False
     ) -> None:
         self.path, self.raw, self.cache_dir, self.force = path, raw, cache_dir, force
+        self.span = (0.0, math.inf)  # the run's (start, stop), once [scene] is read
 
     def fail(self, key: str, message: str) -> ScenarioError:
         return ScenarioError(self.path, key, message)
@@ -281,10 +291,12 @@ class _Loader:
         stop = self.quantity(head["stop"], "scene.stop", "s")
         if not stop > start:
             raise self.fail("scene.stop", f"must be later than scene.start ({start} s), got {stop}")
+        self.span = (start, stop)  # a signal refuses a run past its span
         fmus = self.fmus(self.table(raw["fmus"], "fmus"))
         self.shared_parameters(fmus)
         stop_when = self.stop_when(head["stop_when"], fmus) if "stop_when" in head else None
         connections = self.connections(raw.get("connections", []), fmus)
+        self.signals_not_connected(connections, fmus)
         master = self.master(self.table(raw["master"], "master"), fmus, stop - start)
         record, every, out_dir = self.output(
             self.table(raw.get("output", {}), "output"), fmus, name
@@ -373,8 +385,13 @@ class _Loader:
                 raise self.fail(f"{key}.fmu", str(exc)) from None
             params = self.values(entry.get("parameters", {}), f"{key}.parameters", model)
             inputs = self.values(entry.get("inputs", {}), f"{key}.inputs", model)
+            signals = {n: inputs.pop(n) for n, v in list(inputs.items()) if isinstance(v, Signal)}
+            # Initialization sees each signal's value at the start (before a jump there).
+            inputs.update({n: s.value(self.span[0], left=True) for n, s in signals.items()})
             name = component or model.model_name
-            specs[instance] = FmuSpec(instance, name, path, model, params, inputs, component)
+            specs[instance] = FmuSpec(
+                instance, name, path, model, params, inputs, component, signals
+            )
         return specs
 
     def fmu_file(self, entry: dict[str, Any], key: str) -> tuple[str | None, Path]:
@@ -412,10 +429,25 @@ class _Loader:
         causality = "parameter" if key.endswith(".parameters") else "input"
         node = self.table(node, key)
         declared = {v.name: v for v in model.of(causality)}
+        if causality == "input":
+            node = merge_signal_overrides(node, set(declared))
         self.check_keys(node, key, set(declared))
         return {name: self.value(v, f"{key}.{name}", declared[name]) for name, v in node.items()}
 
+    def signals_not_connected(self, connections: tuple[Connection, ...], fmus) -> None:
+        for c in connections:
+            instance, name = c.target
+            if name in fmus[instance].signals:
+                raise self.fail(
+                    f"fmus.{instance}.inputs.{name}",
+                    f"a signal drives it and so does {'.'.join(c.source)}; give it one driver",
+                )
+
     def value(self, raw: Any, key: str, var: VariableInfo) -> Any:
+        if var.causality == "input" and is_signal(raw):
+            return read_signal(
+                Reader(self.path, self.fail, self.quantity), raw, key, var, self.span
+            )
         if var.type == "Boolean":
             if not isinstance(raw, bool):
                 raise self.fail(key, f"expected true or false, got {raw!r}")
@@ -596,7 +628,7 @@ class _Loader:
                 for inst, spec in fmus.items()
                 for v in spec.model.of("output")
                 if v.type in ("Real", "Integer", "Enumeration")
-            )
+            ) + tuple((inst, n) for inst, spec in fmus.items() for n in spec.signals)
         else:
             if not isinstance(record_raw, list):
                 raise self.fail("output.record", "expected a list of '<instance>.<variable>'")
@@ -765,6 +797,11 @@ class _Loader:
                 raise self.fail(key, f"unknown FMU instance {instance!r} in {dotted!r}")
             causality = "parameter" if kind == "parameters" else "input"
             var = fmus[instance].model.variables.get(name)
+            inputs = {v.name for v in fmus[instance].model.of("input")}
+            shorthand = split_signal_key(inputs, name) if kind == "inputs" else None
+            if shorthand is not None and shorthand[0] in fmus[instance].signals:
+                var = fmus[instance].model.variables[shorthand[0]]
+                return "s" if shorthand[1] == "step" else var.unit or "1"
             if var is None or var.causality != causality:
                 raise self.fail(key, f"{fmus[instance].fmu} has no {causality} {name!r}")
             return var.unit or "1"

@@ -20,6 +20,7 @@ from typing import Any
 
 from orchestrator.run import fmu_files
 from orchestrator.scenario import Scene
+from orchestrator.signals import refuse_signals
 
 SSD = "http://ssp-standard.org/SSP1/SystemStructureDescription"
 SSC = "http://ssp-standard.org/SSP1/SystemStructureCommon"
@@ -148,6 +149,7 @@ def _parameter(parent: ET.Element, var: Any, value: object) -> None:
 def export_ssp(scene: Scene, out: Path, cache_dir: Path | None = None) -> Path:
     """Write ``scene`` as the SSP archive ``out`` (atomically) and return its path."""
     out = Path(out)
+    refuse_signals(scene, "SSP 1.0", "has no time-varying source (export --osp carries it)")
     paths = fmu_files(scene, cache_dir)
     # One file per instance: two instances of one FMU may carry different builds.
     sources = {name: f"resources/{name}.fmu" for name in scene.fmus}

@@ -13,6 +13,7 @@ from typing import Any
 from orchestrator.errors import RunError
 from orchestrator.fmu_instance import FmuInstance
 from orchestrator.scenario import Scene
+from orchestrator.signals import scene_signals
 
 
 @dataclass
@@ -108,6 +109,12 @@ class CoupledSystem:
         self.values: list[list[float]] = [[] for _ in self.names]
         self.ints: list[list[int]] = [[] for _ in self.names]
         self.record_header = [f"{inst}.{var}" for inst, var in scene.record]
+        #: inputs that vary in time: fed around every doStep; masters land on breakpoints
+        self.signals = scene_signals(scene)
+        self.signals.bind(
+            self.names, lambda n, v: self.instance(n).setter(self.instance(n).refs(v))
+        )
+        self._drive = self.signals.apply if self.signals else None  # hot path: no call
 
     def _slot(self, i: int, var: str) -> tuple[str, int]:
         kind = "int" if self.instances[i].is_integer(var) else "real"
@@ -175,7 +182,13 @@ class CoupledSystem:
             set_ints([ints[s][k] for s, k in feed.int_sources])
 
     def step(self, i: int, t: float, h: float) -> None:
-        self.instances[i].do_step(t, h)
+        drive = self._drive
+        if drive is None:
+            self.instances[i].do_step(t, h)
+        else:  # the signals' values at the step start; after the step, at its end
+            drive(i, t)
+            self.instances[i].do_step(t, h)
+            drive(i, t + h)
 
     def record_row(self, t: float) -> list[float]:
         row = [t]

@@ -43,7 +43,14 @@ class FixedStepMaster:
         system, k, n = self.system, self.k, self.n
         m = len(system.instances)
         last = k >= n - 1
-        hk = self.stop - t if last else self.h
+        # On the grid (no accumulated rounding), the last step on stop itself.
+        grid = self.stop if last else self.start + (k + 1) * self.h
+        end, on_grid = grid, True
+        if system.signals:  # an input signal's jump or kink before the grid point
+            end = system.signals.land(t, grid)
+            on_grid = grid - end <= 1e-9 * self.h
+            end = grid if on_grid else end
+        hk = end - t if system.signals else (self.stop - t if last else self.h)
         if self.sequential:  # Gauss–Seidel: each FMU sees the newest outputs
             for i in range(m):
                 system.feed(i)
@@ -54,10 +61,9 @@ class FixedStepMaster:
                 system.feed(i)
                 system.step(i, t, hk)
             system.read_all()
-        self.k += 1
+        self.k += on_grid
         self.stats.do_steps += m
-        # On the grid (no accumulated rounding), the last step on stop itself.
-        return MacroStep(self.stop if last else self.start + (k + 1) * self.h, hk)
+        return MacroStep(end, hk, record=not on_grid)
 
 
 def fixed_step_master(

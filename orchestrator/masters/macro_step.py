@@ -37,6 +37,9 @@ class MacroStep:
     left_row: list[float] | None = None
     #: the step was taken and is recorded, but the run cannot go on (raised after recording)
     failure: RunError | None = None
+    #: the step ends on a known instant (an input signal's breakpoint): recorded whatever
+    #: ``output.every`` says
+    record: bool = False
 
 
 class Master(Protocol):

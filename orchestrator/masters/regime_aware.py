@@ -267,8 +267,8 @@ class RegimeAwareMaster:
         """
         system = self.system
         after_regimes, after_ind = system.regimes(), system.indicators()
-        best: float | None = None
-        reported: float | None = None  # the earliest instant an FMU reported
+        # An input signal's jump where the step ends is a known, located switch.
+        best = reported = t + h if system.signals.jump_at(t + h) else None
         g1 = system.stop_indicator()
         if g1 is not None and g1 <= 0.0 < before.stop:
             best = t + h * before.stop / (before.stop - g1)
@@ -344,7 +344,8 @@ class RegimeAwareMaster:
         exchange there is settled), or as long as the error test allows."""
         cfg, system, stats = self.cfg, self.system, self.stats
         control = self.control
-        h = min(self.h, stop - t)
+        # Ends on an input signal's breakpoint; its hold error within the tolerance.
+        h = system.signals.clip(t, min(self.h, stop - t), cfg.tolerance)
         state = system.get_state()
         before = self.snapshot()  # consistent: every trial and settle ends refreshed
         try:

@@ -35,13 +35,14 @@ from typing import Any
 
 import numpy as np
 
-from orchestrator.errors import RunError
+from orchestrator.errors import RunError, ScenarioError
 from orchestrator.osp_export import export_osp
-from orchestrator.run import RunResult, run_scene
+from orchestrator.run import RunResult, fmu_files, run_scene
 from orchestrator.scenario import Scene, load_scene
+from orchestrator.signals import libcosim_scenario, scene_signals
 from orchestrator.ssp_export import export_ssp
 from orchestrator.ssp_import import load_ssp
-from orchestrator.studies.tool_runs import fmpy_run, libcosim_run
+from orchestrator.studies.tool_runs import fmpy_run, fmpy_simulate_run, libcosim_run
 
 TOOLS = ("libcosim", "fmpy")
 #: the agreement ``mechcosim crosscheck`` requires
@@ -80,8 +81,11 @@ def grid_steps(scene: Scene, until: float) -> int:
     return int(math.floor((until - scene.start) / scene.master.step + 1e-9))
 
 
-def cannot_run(scene: Scene, tool: str) -> str | None:
+def cannot_run(scene: Scene, tool: str, via: str = "ssp") -> str | None:
     """Why ``tool`` cannot run ``scene``'s exported system (None: it can)."""
+    why = _cannot_take_signals(scene, tool, via)
+    if why is not None:
+        return why
     if tool == "libcosim":
         if importlib.util.find_spec("libcosimpy") is None:
             return "libcosimpy is not installed (pip install libcosimpy)"
@@ -103,6 +107,64 @@ def cannot_run(scene: Scene, tool: str) -> str | None:
     return None
 
 
+def _cannot_take_signals(scene: Scene, tool: str, via: str) -> str | None:
+    """Input signals reach libcosim as a scenario file beside the OSP-IS file, and FMPy
+    through simulate_fmu's input table for a scene of one FMU."""
+    signals = scene_signals(scene)
+    if not signals:
+        return None
+    name = ".".join(next(iter(signals.driven)))
+    if tool == "libcosim":
+        if via != "osp":
+            return f"input signal {name}: run libcosim with --via osp"
+        try:
+            libcosim_scenario(scene, scene.master.step)
+        except ScenarioError as exc:
+            return f"{exc.key}: {str(exc).split('] ', 1)[-1]}"
+        return None
+    if len(scene.fmus) > 1:
+        return f"input signal {name}: FMPy's simulate_fmu, which takes signals, runs one FMU"
+    for (instance, var), signal in signals.driven.items():
+        if signal.breakpoints() != signal.jumps:
+            return (
+                f"input signal {instance}.{var} has a slope: FMPy records an output before "
+                "it applies the input of that instant, so outputs that depend on it differ"
+            )
+        if signal.is_jump(scene.start):
+            return (
+                f"input signal {instance}.{var} jumps at the start: FMPy's simulate_fmu holds "
+                "a table's first value over the first step"
+            )
+    return None
+
+
+def _simulate_job(scene: Scene, cache_dir: Path | None) -> dict[str, Any]:
+    """simulate_fmu's arguments for a scene of one FMU driven by held signals."""
+    ((instance, spec),) = scene.fmus.items()
+    driven = scene_signals(scene).driven
+    names = [var for (_, var) in driven]
+    times = sorted({scene.start, scene.stop, *(t for s in driven.values() for t in s.jumps)})
+    table = []
+    for t in times:
+        left = [s.value(t, left=True) for s in driven.values()]
+        right = [s.value(t) for s in driven.values()]
+        table += [[t, *left], [t, *right]] if left != right else [[t, *right]]
+    # Constant Real inputs go in the table too: FMPy warns of an input missing from it.
+    constants = {
+        k: v
+        for k, v in spec.inputs.items()
+        if k not in names and spec.model.variables[k].type == "Real"
+    }
+    names += list(constants)
+    table = [row + list(constants.values()) for row in table]
+    others = {k: v for k, v in spec.inputs.items() if k not in names}
+    return {
+        "fmu": str(fmu_files(scene, cache_dir)[instance]),
+        "inputs": (names, table),
+        "start_values": {**spec.parameters, **others},
+    }
+
+
 def run_tool(
     scene: Scene,
     tool: str,
@@ -113,7 +175,7 @@ def run_tool(
 ) -> ToolRun:
     """Export ``scene`` into ``workdir`` and run ``steps`` fixed macro steps of it in ``tool``
     (libcosim from the SSP archive or, with ``via="osp"``, the OSP-IS file)."""
-    why = cannot_run(scene, tool)
+    why = cannot_run(scene, tool, via)
     if why is not None:
         raise ToolCannotRun(why)
     if tool == "fmpy":
@@ -124,6 +186,8 @@ def run_tool(
     if via == "osp":
         source = export_osp(scene, workdir / "osp", cache_dir)
         what = "OSP-IS file"
+    elif tool == "fmpy" and scene_signals(scene):
+        source, what = workdir, ""  # simulate_fmu runs the FMU file itself
     else:
         archive = export_ssp(scene, workdir / f"{scene.name}.ssp", cache_dir)
         what = "SSP archive"
@@ -138,6 +202,8 @@ def run_tool(
             if kind == "Enumeration":
                 not_compared[name] = "libcosim ignores FMI 2.0 Enumeration variables"
     child = libcosim_run if tool == "libcosim" else fmpy_run
+    if tool == "fmpy" and scene_signals(scene):
+        child, what = fmpy_simulate_run, "simulate_fmu with the input signals"
     job = {
         "source": str(source),
         "record": [r for r in record if f"{r[0]}.{r[1]}" not in not_compared],
@@ -145,6 +211,7 @@ def run_tool(
         "start": scene.start,
         "step": scene.master.step,
         "stop": scene.stop,
+        **(_simulate_job(scene, cache_dir) if child is fmpy_simulate_run else {}),
     }
     started = time.perf_counter()
     with mp.get_context("spawn").Pool(1) as pool:
@@ -161,6 +228,7 @@ def agreement(ours: RunResult, theirs: ToolRun, scene: Scene) -> Agreement:
     on_grid = (k >= 1) & (k <= len(theirs.data))
     on_grid &= np.abs(times - (scene.start + k * scene.master.step)) <= 1e-9 * scene.master.step
     rows = np.flatnonzero(on_grid)
+    rows = rows[np.isfinite(theirs.data[k[rows] - 1, 0])]  # NaN time: a row it did not record
     per_signal: dict[str, float] = {}
     for j, name in enumerate(theirs.header[1:], start=1):
         a = ours.data[rows, ours.header.index(name)]
@@ -224,7 +292,7 @@ def crosscheck(
     }
     scene = load_any(path, overrides, cache_dir)
     steps = grid_steps(scene, scene.stop)
-    outcomes = [Outcome(tool, cannot_run=cannot_run(scene, tool)) for tool in tools]
+    outcomes = [Outcome(tool, cannot_run=cannot_run(scene, tool, via)) for tool in tools]
     wall = math.nan
     with tempfile.TemporaryDirectory(prefix="mechcosim-crosscheck-") as scratch:
         if any(o.cannot_run is None for o in outcomes):

@@ -21,6 +21,8 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
+from orchestrator.signals import SETTABLE, signal_setting
+
 SAMPLING_METHODS = ("sobol", "monte-carlo")
 DISTRIBUTIONS = ("band", "normal", "uniform", "lognormal", "discrete")
 #: A band is read as a normal truncated at this many standard deviations.
@@ -289,7 +291,11 @@ def _scene_value(loader: Any, key: str, fmus: dict[str, Any], where: str) -> flo
     if len(parts) == 4 and parts[0] == "fmus" and parts[1] in fmus:
         spec = fmus[parts[1]]
         given = spec.parameters if parts[2] == "parameters" else spec.inputs
-        value = given.get(parts[3], spec.model.variables[parts[3]].start)
+        shorthand = signal_setting(spec, parts[3]) if parts[2] == "inputs" else None
+        if shorthand is not None:  # a signal's key, e.g. a step's height "u_s.to"
+            value = shorthand[2].settings.get(shorthand[1])
+        else:
+            value = given.get(parts[3], spec.model.variables[parts[3]].start)
         try:
             return float(value)
         except (TypeError, ValueError):
@@ -307,7 +313,11 @@ def _check_range(loader: Any, spec: StudyInput, where: str, fmus: dict[str, Any]
         parts = key.split(".", 3)
         if len(parts) != 4 or parts[0] != "fmus":
             continue
-        var = fmus[parts[1]].model.variables[parts[3]]
+        shorthand = signal_setting(fmus[parts[1]], parts[3])
+        if shorthand is not None and SETTABLE[shorthand[1]] != "value":
+            continue  # a signal's time: the run checks it
+        name = shorthand[0] if shorthand is not None else parts[3]
+        var = fmus[parts[1]].model.variables[name]
         if var.min is not None and math.isfinite(low) and low < var.min:
             raise loader.fail(
                 where, f"reaches {low:.6g} {spec.unit}, below {key}'s minimum {var.min:g}"

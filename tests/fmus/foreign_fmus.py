@@ -473,3 +473,96 @@ def torsion_body_reference(
         tau = torque(phi_in, w_in, phi, w)
         record(i + 1)
     return out
+
+
+PI_CONTROLLER_SOURCE = FOREIGN_DIR / "pi_controller.c"
+# (name, value reference, causality, unit, start, min, max, description); all Real.
+PI_CONTROLLER_VARIABLES = (
+    ("kp", 0, "parameter", "N.m.s/rad", "2e-3", None, None, "proportional gain"),
+    ("ki", 1, "parameter", "N.m/rad", "1e-2", None, None, "integral gain"),
+    ("u_s", 2, "input", "rad/s", "0.0", "-100", "100", "set point (0 at initialization)"),
+    ("u_m", 3, "input", "rad/s", "0.0", None, None, "measured speed"),
+    ("y", 4, "output", "N.m", None, None, None, "drive torque kp*(u_s - u_m) + ki*x"),
+    ("x", 5, "output", "rad", None, None, None, "integral of the error u_s - u_m"),
+)
+
+
+def build_pi_controller(dest: Path) -> Path:
+    """Compile PiController (its initialization fails unless the set point u_s is 0) and
+    pack it as ``dest/PiController.fmu``; return its path."""
+    compiler = c_compiler()
+    if compiler is None:
+        raise ForeignFmuError("no C compiler (cc, gcc or $CC) on PATH")
+    platform_dir, suffix = fmi2_platform()
+    dest = Path(dest)
+    dest.mkdir(parents=True, exist_ok=True)
+    guid = "{" + str(uuid.uuid4()) + "}"
+    target = dest / "PiController.fmu"
+    with tempfile.TemporaryDirectory(prefix="pi_controller_") as tmp:
+        library = Path(tmp) / ("PiController" + suffix)
+        command = [
+            compiler,
+            "-std=c99",
+            "-O2",
+            "-ffp-contract=off",
+            "-fPIC",
+            "-shared",
+            "-Wall",
+            f"-I{fmi_headers_dir()}",
+            f'-DPI_CONTROLLER_GUID="{guid}"',
+            str(PI_CONTROLLER_SOURCE),
+            "-o",
+            str(library),
+        ]
+        result = subprocess.run(command, capture_output=True, text=True)
+        if result.returncode != 0:
+            raise ForeignFmuError(f"compiling {PI_CONTROLLER_SOURCE.name} failed:\n{result.stderr}")
+        partial = target.with_suffix(".fmu.part")
+        with zipfile.ZipFile(partial, "w", zipfile.ZIP_DEFLATED) as z:
+            z.writestr("modelDescription.xml", _pi_controller_model_description(guid))
+            z.write(library, f"binaries/{platform_dir}/{library.name}")
+        partial.replace(target)
+    return target
+
+
+def _pi_controller_model_description(guid: str) -> bytes:
+    root = ET.Element(
+        "fmiModelDescription",
+        fmiVersion="2.0",
+        modelName="PiController",
+        guid=guid,
+        description="PI controller whose initial equations need a zero set point",
+        generationTool="hand-written C (tests/fmus/foreign/pi_controller.c)",
+        numberOfEventIndicators="0",
+    )
+    ET.SubElement(
+        root,
+        "CoSimulation",
+        modelIdentifier="PiController",
+        canHandleVariableCommunicationStepSize="true",
+        canGetAndSetFMUstate="true",
+    )
+    unit_defs = ET.SubElement(root, "UnitDefinitions")
+    for name in sorted({v[3] for v in PI_CONTROLLER_VARIABLES}):
+        unit = ET.SubElement(unit_defs, "Unit", name=name)
+        ET.SubElement(unit, "BaseUnit", {k: str(e) for k, e in UNITS[name].items()})
+    ET.SubElement(root, "DefaultExperiment", DEFAULT_EXPERIMENT)
+    model_vars = ET.SubElement(root, "ModelVariables")
+    for name, vr, causality, unit, start, low, high, description in PI_CONTROLLER_VARIABLES:
+        variability = "fixed" if causality == "parameter" else "continuous"
+        attrs = {"name": name, "valueReference": str(vr), "causality": causality}
+        attrs.update(variability=variability, description=description)
+        if causality == "output":
+            attrs["initial"] = "calculated"
+        sv = ET.SubElement(model_vars, "ScalarVariable", attrs)
+        real = {"unit": unit}
+        real.update({k: v for k, v in (("start", start), ("min", low), ("max", high)) if v})
+        ET.SubElement(sv, "Real", real)
+    structure = ET.SubElement(root, "ModelStructure")
+    outputs = ET.SubElement(structure, "Outputs")
+    ET.SubElement(outputs, "Unknown", index="5", dependencies="3 4")
+    ET.SubElement(outputs, "Unknown", index="6", dependencies="")
+    initial = ET.SubElement(structure, "InitialUnknowns")
+    ET.SubElement(initial, "Unknown", index="5", dependencies="1 2 3 4")
+    ET.SubElement(initial, "Unknown", index="6", dependencies="")
+    return parseString(ET.tostring(root, "UTF-8")).toprettyxml(indent="  ", encoding="UTF-8")
