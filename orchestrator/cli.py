@@ -34,6 +34,12 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument(
         "--force", action="store_true", help="run even a scene of more than 1e8 macro steps"
     )
+    p.add_argument(
+        "--in-process",
+        action="store_true",
+        help="run in this process, not a supervised child: an FMU that crashes then ends "
+        "the command without a summary (for a debugger)",
+    )
     p.set_defaults(handler=_run)
 
     p = sub.add_parser("check", help="validate a scenario file without running it")
@@ -143,7 +149,7 @@ def main(argv: list[str] | None = None) -> int:
     p.set_defaults(handler=_stability)
 
     p = sub.add_parser("bench", help="run a benchmark (prints ratios against its baseline)")
-    p.add_argument("name", choices=["overhead", "m739", "speed"])
+    p.add_argument("name", choices=["overhead", "m739", "speed", "supervision"])
     p.set_defaults(handler=_bench)
 
     p = sub.add_parser("report", help="print the summary of a finished run")
@@ -151,10 +157,15 @@ def main(argv: list[str] | None = None) -> int:
     p.set_defaults(handler=_report)
 
     args = parser.parse_args(argv)
+    return _handled(args.handler, args)
+
+
+def _handled(handler, args: argparse.Namespace) -> int:  # noqa: ANN001 - a command handler
+    """Run a command's handler; an error becomes one line and an exit code."""
     from fmus.build import BuildError  # before the try: its except clauses name it
 
     try:
-        return args.handler(args)
+        return handler(args)
     except (KeyboardInterrupt, Interrupted) as exc:
         if args.debug:
             raise
@@ -211,10 +222,19 @@ def _floats(text: str) -> tuple[float, ...]:
 
 def _run(args: argparse.Namespace) -> int:
     from orchestrator.interrupt import catching_signals
+    from orchestrator.supervisor import can_supervise, supervised
 
     # From here on SIGINT/SIGTERM only set a flag: the run stops at a step boundary.
     with catching_signals() as guard:
-        code = _run_guarded(args)
+        if args.in_process or not can_supervise():
+            code = _run_guarded(args)
+        else:
+            # The run in a child process, under this guard; a crash there is reported here.
+            def child(args: argparse.Namespace) -> int:
+                code = _run_guarded(args)
+                return 128 + guard.signum if guard.signum is not None else code
+
+            return supervised(lambda: _handled(child, args), guard)
     if guard.signum is not None:
         return 128 + guard.signum
     return code

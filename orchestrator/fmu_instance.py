@@ -32,6 +32,7 @@ from fmpy.fmi2 import (  # the allocators fmpy itself hands to FMUs, and its val
     free,
 )
 
+from orchestrator import flight
 from orchestrator.errors import RunError
 
 _UNPACKED: dict[str, tuple[Any, str]] = {}
@@ -45,9 +46,16 @@ def _unpacked(fmu_path: str) -> tuple[Any, str]:
 
 
 @atexit.register
-def _remove_unpacked() -> None:
-    for _, directory in _UNPACKED.values():
-        shutil.rmtree(directory, ignore_errors=True)
+def _remove_unpacked(keep: frozenset[str] = frozenset()) -> None:
+    """Remove the unzip directories, but those of the FMU files in ``keep``."""
+    for fmu_path, (_, directory) in _UNPACKED.items():
+        if fmu_path not in keep:
+            shutil.rmtree(directory, ignore_errors=True)
+
+
+def unpacked_files() -> frozenset[str]:
+    """FMU files unpacked by this process so far (a forked child shares their folders)."""
+    return frozenset(_UNPACKED)
 
 
 def file_sha256(path: Path) -> str:
@@ -68,12 +76,19 @@ class FmuInstance:
         self._callbacks.logger = fmi2CallbackLoggerTYPE(self._log)
         self._callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
         self._callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
+        # Every FMI call is noted before it is made (orchestrator.flight): a crash inside
+        # the FMU can then be told apart and named by a supervising process.
+        self._flight = flight.current().record
+        self._slot = flight.current().register(instance_name)
+        self._flight.instance, self._flight.call = self._slot, flight.CALL_INDEX[flight.CALLS[1]]
         self.fmu = FMU2Slave(
             guid=md.guid,
             unzipDirectory=unzip_dir,
             modelIdentifier=md.coSimulation.modelIdentifier,
             instanceName=instance_name,
         )
+        self._flight.call = 0
+        self.fmu._call = self._noted(self.fmu._call)
         self.fmu.instantiate(callbacks=self._callbacks, loggingOn=True)
         self._alive = True
         self._freeable = True
@@ -123,7 +138,9 @@ class FmuInstance:
     def do_step(self, t: float, h: float) -> None:
         logged = len(self.messages)
         try:
+            self._flight.time = t
             self._do_step(self.fmu.component, t, h, fmi2True)
+            self._flight.time = t + h
         except FMICallException as exc:
             self._alive = False
             raise RunError(
@@ -147,11 +164,28 @@ class FmuInstance:
     # Prepared transfers for the hot path: the reference and value arrays are built once
     # and the FMI function is called directly (fmpy builds both arrays on every call and
     # goes through its call logger; together about half the cost of a small transfer).
+    def _noted(self, call: Callable[..., Any]) -> Callable[..., Any]:
+        """fmpy's FMI call (``FMU2Slave._call``), noted in the flight record."""
+        record, slot, index = self._flight, self._slot, flight.CALL_INDEX
+
+        def noted(name: str, *args: Any) -> Any:
+            record.instance, record.call = slot, index.get(name, 0)
+            try:
+                return call(name, *args)
+            finally:
+                record.call = 0
+
+        return noted
+
     def _function(self, name: str) -> Callable[..., int]:
         raw = self.fmu._functions[name]
+        record, slot, index = self._flight, self._slot, flight.CALL_INDEX[name]
 
         def call(*args: Any) -> int:
+            record.instance = slot
+            record.call = index
             status = raw(*args)
+            record.call = 0
             if status > 1:  # fmi2Discard, fmi2Error, fmi2Fatal (as fmpy raises them)
                 raise FMICallException(function=name, status=status)
             return status

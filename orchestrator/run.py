@@ -25,6 +25,7 @@ from fmus.build import build_fmu
 from orchestrator.accuracy import compare
 from orchestrator.analyses import energy_residual, headline, missing_column
 from orchestrator.errors import RunError
+from orchestrator.flight import announce_run
 from orchestrator.fmu_instance import file_sha256
 from orchestrator.interrupt import Interrupted, SignalGuard, catching_signals, signal_name
 from orchestrator.masters import MASTERS
@@ -80,6 +81,7 @@ def run_scene(
     """
     out = Path(output_dir) if output_dir else scene.output_dir
     with catching_signals() as guard, OutputLock(out):
+        announce_run(scene, out)  # for a supervisor, should this process crash
         return _run_locked(scene, out, cache_dir, show_progress, compare_reference, plots, guard)
 
 

@@ -157,14 +157,36 @@ def fmi_headers_dir() -> Path:
     return Path(fmpy.__file__).resolve().parent / "c-code"
 
 
-def build_torsion_body(dest: Path, can_get_set_state: bool = True, phi0_in_degrees=False) -> Path:
-    """Compile TorsionBody and pack it as ``dest/TorsionBody[-nostate][-deg].fmu``; return
-    its path.
+# Misbehaviours a TorsionBody can be built with (torsion_body.c, TORSION_BODY_FAULT).
+FAULTS = (
+    "segfault",  # doStep writes through a null pointer (SIGSEGV)
+    "abort",  # doStep calls abort() (SIGABRT)
+    "exit",  # doStep calls exit(3)
+    "get_real",  # fmi2GetReal fails (and logs why, with printf arguments)
+    "terminate",  # doStep returns fmi2Discard with fmi2Terminated true
+    "get_state",  # fmi2GetFMUstate fails
+    "instantiate",  # fmi2Instantiate returns NULL
+)
+
+
+def build_torsion_body(
+    dest: Path,
+    can_get_set_state: bool = True,
+    phi0_in_degrees: bool = False,
+    fault: str | None = None,
+    fault_time: float = 0.0,
+) -> Path:
+    """Compile TorsionBody and pack it as ``dest/TorsionBody[-nostate][-deg][-<fault>].fmu``;
+    return its path.
 
     Every build gets a fresh GUID, compiled into the binary (which refuses to instantiate
     with any other) and written into the model description.  ``phi0_in_degrees``: the
-    parameter ``body.phi0`` is declared (and taken) in ``deg``, not SI.
+    parameter ``body.phi0`` is declared (and taken) in ``deg``, not SI.  ``fault``: one of
+    ``FAULTS``, from the first doStep that starts at ``fault_time`` [s] (doStep faults and
+    ``get_real``) or at once (the others).
     """
+    if fault is not None and fault not in FAULTS:
+        raise ValueError(f"unknown fault {fault!r}; expected one of {FAULTS}")
     compiler = c_compiler()
     if compiler is None:
         raise ForeignFmuError("no C compiler (cc, gcc or $CC) on PATH")
@@ -173,7 +195,8 @@ def build_torsion_body(dest: Path, can_get_set_state: bool = True, phi0_in_degre
     dest.mkdir(parents=True, exist_ok=True)
     guid = "{" + str(uuid.uuid4()) + "}"
     name = MODEL_IDENTIFIER + ("" if can_get_set_state else "-nostate")
-    target = dest / (name + ("-deg" if phi0_in_degrees else "") + ".fmu")
+    name += "-deg" if phi0_in_degrees else ""
+    target = dest / (name + (f"-{fault}" if fault else "") + ".fmu")
 
     with tempfile.TemporaryDirectory(prefix="torsion_body_") as tmp:
         library = Path(tmp) / (MODEL_IDENTIFIER + suffix)
@@ -192,6 +215,14 @@ def build_torsion_body(dest: Path, can_get_set_state: bool = True, phi0_in_degre
             f'-DTORSION_BODY_GUID="{guid}"',
             *(["-DTORSION_BODY_FMU_STATE"] if can_get_set_state else []),
             *(["-DTORSION_BODY_PHI0_DEG"] if phi0_in_degrees else []),
+            *(
+                [
+                    f"-DTORSION_BODY_FAULT=FAULT_{fault.upper()}",
+                    f"-DTORSION_BODY_FAULT_TIME={fault_time!r}",
+                ]
+                if fault
+                else []
+            ),
             str(TORSION_BODY_SOURCE),
             "-o",
             str(library),
