@@ -26,7 +26,7 @@ from orchestrator.accuracy import compare
 from orchestrator.analyses import energy_residual, headline, missing_column
 from orchestrator.errors import RunError
 from orchestrator.flight import announce_run
-from orchestrator.fmu_instance import file_sha256
+from orchestrator.fmu_instance import FmuTerminated, file_sha256
 from orchestrator.interrupt import Interrupted, SignalGuard, catching_signals, signal_name
 from orchestrator.masters import MASTERS
 from orchestrator.output_lock import OutputLock
@@ -35,6 +35,7 @@ from orchestrator.recorder import Recorder, StepStats
 from orchestrator.scenario import Scene
 from orchestrator.scenes import ANALYSES, PLOTS, REFERENCES
 from orchestrator.scenes.family import Reference
+from orchestrator.summary_file import not_started_summary, write_summary
 from orchestrator.system import CoupledSystem
 
 PROJECT_DIR = Path(__file__).resolve().parent.parent
@@ -95,7 +96,11 @@ def _run_locked(
     guard: SignalGuard,
 ) -> RunResult:
     fmu_paths = fmu_files(scene, cache_dir)
-    system = CoupledSystem(scene, fmu_paths)
+    try:
+        system = CoupledSystem(scene, fmu_paths)
+    except RunError as exc:  # an FMU that cannot be instantiated: say so in the results too
+        write_summary(out, not_started_summary(scene, str(exc)))
+        raise
     try:
         recorder = Recorder(out, system.record_header)
     except OSError as exc:
@@ -130,6 +135,10 @@ def _run_locked(
         system.initialize()
         guard.check()
         MASTERS[scene.master.algorithm](system, scene, recorder, stats, progress)
+    except FmuTerminated as exc:  # as FMPy does: the run ends there, with what it has
+        message = str(exc)
+        notes.append(message)
+        reached[0] = exc.time
     except RunError as exc:
         status, message = "failed", str(exc)
         if exc.time is not None:

@@ -32,6 +32,9 @@ from orchestrator.scenes.family import Option
 from orchestrator.studies.study_table import StudySpec, parse_study
 from orchestrator.units import to_si
 
+#: FMI types a run can record (a Boolean as 0 or 1; a String is no number)
+RECORDED_TYPES = ("Real", "Integer", "Enumeration", "Boolean")
+
 REDUCTIONS = ("final", "initial", "max", "min", "maxabs", "mean")
 
 #: More macro steps than this cannot finish in any sensible time: refused unless forced.
@@ -595,15 +598,20 @@ class _Loader:
                 (inst, v.name)
                 for inst, spec in fmus.items()
                 for v in spec.model.of("output")
-                if v.type in ("Real", "Integer", "Enumeration")
+                if v.type in RECORDED_TYPES
             )
         else:
             if not isinstance(record_raw, list):
                 raise self.fail("output.record", "expected a list of '<instance>.<variable>'")
             record = tuple(self.signal(s, "output.record", fmus, None) for s in record_raw)
             for inst, var in record:
-                if fmus[inst].model.variables[var].type not in ("Real", "Integer", "Enumeration"):
-                    raise self.fail("output.record", f"{inst}.{var}: only numbers are recorded")
+                kind = fmus[inst].model.variables[var].type
+                if kind not in RECORDED_TYPES:
+                    raise self.fail(
+                        "output.record",
+                        f"{inst}.{var} is a {kind}: only {', '.join(RECORDED_TYPES)} "
+                        "variables are recorded (Booleans as 0/1)",
+                    )
         every = node.get("every", 1)
         if not isinstance(every, int) or isinstance(every, bool) or every < 1:
             raise self.fail("output.every", f"expected a positive integer, got {every!r}")

@@ -18,7 +18,6 @@ import codecs
 import contextlib
 import ctypes
 import io
-import json
 import os
 import signal
 import sys
@@ -31,6 +30,7 @@ from typing import Any, TextIO
 
 from orchestrator import flight
 from orchestrator.interrupt import SIGNALS, SignalGuard, signal_name
+from orchestrator.summary_file import write_summary
 
 CRASHED = "crashed"
 
@@ -289,9 +289,7 @@ def _write_summary(out: Path, summary: dict[str, Any]) -> bool:
 
     try:
         with OutputLock(out):
-            partial = out / "summary.json.part"
-            partial.write_text(json.dumps(summary, indent=2, default=str))
-            os.replace(partial, out / "summary.json")
+            write_summary(out, summary)
     except Exception as exc:  # noqa: BLE001 - the crash is reported even so
         print(f"error: cannot write {out / 'summary.json'}: {exc}", file=sys.stderr)
         return False

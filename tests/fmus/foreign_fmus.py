@@ -98,6 +98,11 @@ TORSION_BODY_VARIABLES: tuple[tuple[str, int, str, str, str | None, str | None, 
     ("flange.tau", 9, "Real", "output", "N.m", None, "torque on the other body"),
 )
 VALUE_REFERENCES: dict[str, int] = {v[0]: v[1] for v in TORSION_BODY_VARIABLES}
+# With flags=True (TORSION_BODY_FLAGS): a Boolean and a String output.
+FLAG_VARIABLES: tuple[tuple[str, int, str, str, str | None, str | None, str], ...] = (
+    ("body.ahead", 0, "Boolean", "output", None, None, "body ahead of the flange"),
+    ("body.label", 0, "String", "output", None, None, "name of the model"),
+)
 
 # FMI base-unit exponents, written out so this fixture depends on nothing in the project.
 UNITS: dict[str, dict[str, int]] = {
@@ -175,6 +180,7 @@ def build_torsion_body(
     phi0_in_degrees: bool = False,
     fault: str | None = None,
     fault_time: float = 0.0,
+    flags: bool = False,
 ) -> Path:
     """Compile TorsionBody and pack it as ``dest/TorsionBody[-nostate][-deg][-<fault>].fmu``;
     return its path.
@@ -183,7 +189,8 @@ def build_torsion_body(
     with any other) and written into the model description.  ``phi0_in_degrees``: the
     parameter ``body.phi0`` is declared (and taken) in ``deg``, not SI.  ``fault``: one of
     ``FAULTS``, from the first doStep that starts at ``fault_time`` [s] (doStep faults and
-    ``get_real``) or at once (the others).
+    ``get_real``) or at once (the others).  ``flags``: with a Boolean and a String output
+    (``FLAG_VARIABLES``).
     """
     if fault is not None and fault not in FAULTS:
         raise ValueError(f"unknown fault {fault!r}; expected one of {FAULTS}")
@@ -196,6 +203,7 @@ def build_torsion_body(
     guid = "{" + str(uuid.uuid4()) + "}"
     name = MODEL_IDENTIFIER + ("" if can_get_set_state else "-nostate")
     name += "-deg" if phi0_in_degrees else ""
+    name += "-flags" if flags else ""
     target = dest / (name + (f"-{fault}" if fault else "") + ".fmu")
 
     with tempfile.TemporaryDirectory(prefix="torsion_body_") as tmp:
@@ -215,6 +223,7 @@ def build_torsion_body(
             f'-DTORSION_BODY_GUID="{guid}"',
             *(["-DTORSION_BODY_FMU_STATE"] if can_get_set_state else []),
             *(["-DTORSION_BODY_PHI0_DEG"] if phi0_in_degrees else []),
+            *(["-DTORSION_BODY_FLAGS"] if flags else []),
             *(
                 [
                     f"-DTORSION_BODY_FAULT=FAULT_{fault.upper()}",
@@ -234,7 +243,7 @@ def build_torsion_body(
                 f"compiling {TORSION_BODY_SOURCE.name} failed:\n{' '.join(command)}\n"
                 f"{result.stdout}{result.stderr}"
             )
-        xml = torsion_body_model_description(guid, can_get_set_state, phi0_in_degrees)
+        xml = torsion_body_model_description(guid, can_get_set_state, phi0_in_degrees, flags)
         partial = target.with_suffix(".fmu.part")
         with zipfile.ZipFile(partial, "w", zipfile.ZIP_DEFLATED) as z:
             z.writestr("modelDescription.xml", xml)
@@ -245,11 +254,11 @@ def build_torsion_body(
 
 
 def torsion_body_model_description(
-    guid: str, can_get_set_state: bool, phi0_in_degrees: bool = False
+    guid: str, can_get_set_state: bool, phi0_in_degrees: bool = False, flags: bool = False
 ) -> bytes:
     """modelDescription.xml of TorsionBody (FMI 2.0, co-simulation)."""
     units = dict(UNITS)
-    variables = TORSION_BODY_VARIABLES
+    variables = TORSION_BODY_VARIABLES + (FLAG_VARIABLES if flags else ())
     if phi0_in_degrees:
         units["deg"] = {"rad": 1, "factor": math.pi / 180.0}
         variables = tuple((*v[:4], "deg", *v[5:]) if v[0] == "body.phi0" else v for v in variables)
@@ -301,9 +310,10 @@ def torsion_body_model_description(
         ET.SubElement(sv, type_, type_attrs)
 
     structure = ET.SubElement(root, "ModelStructure")
+    more = {"body.ahead": ("flange.phi",), "body.label": ()} if flags else {}
     for element, dependencies in (
-        ("Outputs", OUTPUT_DEPENDENCIES),
-        ("InitialUnknowns", INITIAL_DEPENDENCIES),
+        ("Outputs", OUTPUT_DEPENDENCIES | more),
+        ("InitialUnknowns", INITIAL_DEPENDENCIES | more),
     ):
         unknowns = ET.SubElement(structure, element)
         for name in sorted(dependencies, key=index.__getitem__):

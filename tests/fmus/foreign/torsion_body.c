@@ -23,6 +23,9 @@
  *                           and fmi2Terminated is true: the model asks to end the simulation);
  *                           and at any time FAULT_GET_STATE (fmi2GetFMUstate fails),
  *                           FAULT_INSTANTIATE (fmi2Instantiate returns NULL)
+ *   TORSION_BODY_FLAGS      if defined, two more outputs: the Boolean body.ahead (vr 0: the
+ *                           body's angle is ahead of the flange's) and the String body.label
+ *                           (vr 0: "TorsionBody")
  */
 
 #include <math.h>
@@ -314,6 +317,42 @@ fmi2Status fmi2GetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t
     return fmi2OK;
 }
 
+#ifdef TORSION_BODY_FLAGS
+
+fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+                          fmi2Boolean value[]) {
+    Instance *inst = (Instance *)c;
+    size_t i;
+    if (inst == NULL) return fmi2Error;
+    if (nvr > 0 && (vr == NULL || value == NULL)) return fmi2Error;
+    for (i = 0; i < nvr; i++) {
+        if (vr[i] != 0) {
+            LOG_ERROR(inst, "fmi2GetBoolean: unknown value reference %u", vr[i]);
+            return fmi2Error;
+        }
+        value[i] = inst->s.r[VR_PHI] > inst->s.r[VR_PHI_IN] ? fmi2True : fmi2False;
+    }
+    return fmi2OK;
+}
+
+fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+                         fmi2String value[]) {
+    Instance *inst = (Instance *)c;
+    size_t i;
+    if (inst == NULL) return fmi2Error;
+    if (nvr > 0 && (vr == NULL || value == NULL)) return fmi2Error;
+    for (i = 0; i < nvr; i++) {
+        if (vr[i] != 0) {
+            LOG_ERROR(inst, "fmi2GetString: unknown value reference %u", vr[i]);
+            return fmi2Error;
+        }
+        value[i] = "TorsionBody";
+    }
+    return fmi2OK;
+}
+
+#else
+
 fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
                           fmi2Boolean value[]) {
     Instance *inst = (Instance *)c;
@@ -335,6 +374,8 @@ fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t 
     LOG_ERROR(inst, "TorsionBody has no String variables");
     return fmi2Error;
 }
+
+#endif
 
 fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
                        const fmi2Real value[]) {
