@@ -72,6 +72,9 @@ def main(argv: list[str] | None = None) -> int:
         metavar="DIR",
         help="also write libcosim's OspSystemStructure.xml with the FMUs beside it into DIR",
     )
+    p.add_argument(
+        "--force", action="store_true", help="replace an existing archive (never a scene file)"
+    )
     p.set_defaults(handler=_export)
 
     p = sub.add_parser(
@@ -324,6 +327,9 @@ def _export(args: argparse.Namespace) -> int:
     if args.osp is not None and args.osp.exists() and not args.osp.is_dir():
         print(f"error: --osp {args.osp}: is a file; expected a directory", file=sys.stderr)
         return 2
+    from orchestrator.export_target import check_export_target
+
+    check_export_target(args.scene, args.out, args.force)
     scene = load_scene(args.scene, _overrides(args.set))
     out = export_ssp(scene, args.out)
     print(f"{out}: {len(scene.fmus)} components, {len(scene.connections)} connections")

@@ -264,6 +264,18 @@ class _Loader:
             raise self.fail(dotted, f"expected a string, got {node[key]!r}")
         return node[key]
 
+    def scene_name(self, name: str) -> str:
+        """A scene's name names its results directory (runs/<name>): a name, not a path."""
+        if not name.strip():
+            raise self.fail("scene.name", "empty; expected a name such as 'm739_run1'")
+        bad = [c for c in ("/", "\\", "\0") if c in name]
+        if bad or name in (".", "..") or any(ord(c) < 32 for c in name):
+            raise self.fail(
+                "scene.name",
+                f"{name!r} is not a name: no path separators, control characters, '.' or '..'",
+            )
+        return name
+
     # -- sections ---------------------------------------------------------------------
     def scene(self) -> Scene:
         raw = self.table(self.raw, "")
@@ -277,7 +289,10 @@ class _Loader:
                 raise self.fail(section, "missing section")
         head = self.table(raw["scene"], "scene")
         self.check_keys(head, "scene", {"name", "description", "start", "stop", "stop_when"})
-        name = self.string(head, "name", "scene.name")
+        name = self.scene_name(self.string(head, "name", "scene.name"))
+        description = head.get("description", "")
+        if not isinstance(description, str):
+            raise self.fail("scene.description", f"expected text, got {description!r}")
         start = self.quantity(head.get("start", 0.0), "scene.start", "s")
         if "stop" not in head:
             raise self.fail("scene.stop", "missing; expected the stop time, e.g. '0.1 s'")
@@ -300,7 +315,7 @@ class _Loader:
         return Scene(
             path=self.path,
             name=name,
-            description=head.get("description", ""),
+            description=description,
             start=start,
             stop=stop,
             fmus=fmus,
