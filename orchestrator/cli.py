@@ -143,6 +143,11 @@ def main(argv: list[str] | None = None) -> int:
         "--resume", action="store_true", help="keep the samples in samples.csv, run the rest"
     )
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    p.add_argument(
+        "--keep-going",
+        action="store_true",
+        help="run every sample even when the first ones all fail with the same error",
+    )
     p.set_defaults(handler=_study)
 
     p = sub.add_parser("stability", help="run the stability suite (scenarios/stability/)")
@@ -421,7 +426,12 @@ def _study(args: argparse.Namespace) -> int:
         overrides=_overrides(args.set) or None,
         output_dir=args.output,
         show_progress=not args.no_progress,
+        keep_going=args.keep_going,
     )
+    for note in result.notes:
+        print(f"note: {note}", file=sys.stderr)
+    if result.stopped:
+        print(f"error: study {result.scene.name}: {result.stopped}", file=sys.stderr)
     ok = sum(s.status == OK for s in result.samples)
     print(
         f"study {result.scene.name}: {len(result.samples)} of {result.requested} samples, "
@@ -439,7 +449,7 @@ def _study(args: argparse.Namespace) -> int:
     print(f"results in {result.output_dir} (samples.csv, study.md, study.png)")
     if result.interrupted is not None:
         return 128 + result.interrupted
-    return 0 if ok else 1
+    return 0 if ok and not result.stopped else 1
 
 
 def _stability(args: argparse.Namespace) -> int:
