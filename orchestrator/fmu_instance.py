@@ -83,11 +83,12 @@ def _log_message(env: Any, instance: bytes, status: int, category: bytes, messag
 _LOGGER = fmi2CallbackLoggerTYPE(_log_message)
 
 
-def _formats_its_messages(md: Any) -> bool:
-    """Whether an FMU's log messages are printf formats, as FMI says.  PythonFMU's runtime
-    passes its text as the format itself (a '%' in it is no directive): its messages are
-    taken as they come."""
-    return not (md.generationTool or "").startswith("PythonFMU")
+def _made_by_pythonfmu(md: Any) -> bool:
+    """PythonFMU's runtime departs from FMI 2.0 in two ways that matter here: it passes a
+    log message as the printf format itself (a '%' in it is no directive), so its messages
+    are taken as they come; and after any doStep that returns False it reports
+    fmi2Terminated true, so with it a discarded step is no request to end the simulation."""
+    return (md.generationTool or "").startswith("PythonFMU")
 
 
 def _unpacked(fmu_path: str) -> tuple[Any, str]:
@@ -131,7 +132,8 @@ class FmuInstance:
         self._callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
         self._callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
         self._callbacks.componentEnvironment = self._env
-        if _formats_its_messages(md):
+        self._pythonfmu = _made_by_pythonfmu(md)
+        if not self._pythonfmu:
             from fmpy.logging import addLoggerProxy
 
             addLoggerProxy(byref(self._callbacks))
@@ -234,7 +236,9 @@ class FmuInstance:
 
     def _asks_to_terminate(self) -> bool:
         """fmi2GetBooleanStatus(fmi2Terminated) after a doStep that returned fmi2Discard:
-        the FMU asks to end the simulation (FMI 2.0, 4.2.3)."""
+        the FMU asks to end the simulation (FMI 2.0, 4.2.3).  Not asked of PythonFMU's."""
+        if self._pythonfmu:
+            return False
         try:
             return self.fmu.getBooleanStatus(fmi2Terminated)
         except RunError:  # the FMU cannot say: a plain discard
