@@ -118,7 +118,7 @@ def scene_table(
                 continue
             real = parameter.find(f"{{{SSV}}}Real")
             if real is not None and real.get("unit"):
-                value = _in_declared_unit(fmu, name, value, real.get("unit"), units)
+                value = _in_declared_unit(fmu, name, value, real.get("unit"), units, (ssd, where))
             table = "inputs" if name in inputs else "parameters"
             entry.setdefault(table, {})[name] = value
         raw["fmus"][instance] = entry
@@ -195,7 +195,12 @@ def _unit_definitions(root: ET.Element, ssd: str | Path) -> dict[str, Unit]:
 
 
 def _in_declared_unit(
-    fmu: Path, name: str, value: float, unit: str, ssd_units: dict[str, Unit]
+    fmu: Path,
+    name: str,
+    value: float,
+    unit: str,
+    ssd_units: dict[str, Unit],
+    where: tuple[str | Path, str] | None = None,
 ) -> float:
     """A bound Real value in the unit its FMU declares for the variable (SSP 1.0: a
     parameter value's unit may differ from the connector's; the tool converts).  The scene
@@ -209,9 +214,10 @@ def _in_declared_unit(
         return value
     source, target = _base(unit, ssd_units, model), _base(var.unit, ssd_units, model)
     if source is None or target is None or source[0] != target[0]:
+        ssd, key = where or (fmu.parent.parent / "SystemStructure.ssd", name)
         raise ScenarioError(
-            fmu.parent.parent / "SystemStructure.ssd",
-            name,
+            ssd,
+            key,
             f"bound in {unit!r}, which cannot be converted to the FMU's unit {var.unit!r}",
         )
     in_base = value * source[1] + source[2]
