@@ -481,7 +481,7 @@ def _report(args: argparse.Namespace) -> int:
     if not isinstance(summary, dict) or not isinstance(summary.get("status"), str):
         print(f"error: {summary_file} is not a run summary (no status)", file=sys.stderr)
         return 2
-    keys = ("scene", "status", "message", "time_reached", "headline", "notes", "stats")
+    keys = ("scene", "status", "message", "time_reached", "crash", "headline", "notes", "stats")
     print(json.dumps({k: summary[k] for k in keys if k in summary}, indent=2))
     return 0
 
