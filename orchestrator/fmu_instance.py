@@ -139,16 +139,16 @@ class FmuInstance:
             addLoggerProxy(byref(self._callbacks))
         # Every FMI call is noted before it is made (orchestrator.flight): a crash inside
         # the FMU can then be told apart and named by a supervising process.
-        self._flight = flight.current().record
+        self._flight = flight.current()
         self._slot = flight.current().register(instance_name)
-        self._flight.instance, self._flight.call = self._slot, flight.CALL_INDEX[flight.CALLS[1]]
+        self._flight.words[flight.CALL] = flight.call_word(self._slot, flight.CALLS[1])
         self.fmu = FMU2Slave(
             guid=md.guid,
             unzipDirectory=unzip_dir,
             modelIdentifier=md.coSimulation.modelIdentifier,
             instanceName=instance_name,
         )
-        self._flight.call = 0
+        self._flight.words[flight.CALL] = flight.call_word(self._slot, "")
         self.fmu._call = self._noted(self.fmu._call)
         self._alive = self._freeable = False
         try:
@@ -222,9 +222,7 @@ class FmuInstance:
     def do_step(self, t: float, h: float) -> None:
         logged = len(self.messages)
         try:
-            self._flight.time = t
             self._do_step(self.fmu.component, t, h, fmi2True)
-            self._flight.time = t + h
         except FmiCallError as exc:
             self._alive = False
             said = self.said_since(logged) or f"fmi2DoStep returned {STATUS_NAMES[exc.status]}"
@@ -263,28 +261,43 @@ class FmuInstance:
     # goes through its call logger; together about half the cost of a small transfer).
     def _noted(self, call: Callable[..., Any]) -> Callable[..., Any]:
         """fmpy's FMI call (``FMU2Slave._call``), noted in the flight record."""
-        record, slot, index = self._flight, self._slot, flight.CALL_INDEX
+        words, at, slot = self._flight.words, flight.CALL, self._slot
+        idle = flight.call_word(slot, "")
 
         def noted(name: str, *args: Any) -> Any:
-            record.instance, record.call = slot, index.get(name, 0)
+            words[at] = flight.call_word(slot, name)
             try:
                 return call(name, *args)
             except FMICallException as exc:
                 raise self._failed(name, exc.status) from None
             finally:
-                record.call = 0
+                words[at] = idle
 
         return noted
 
     def _function(self, name: str) -> Callable[..., int]:
         raw = self.fmu._functions[name]
-        record, slot, index = self._flight, self._slot, flight.CALL_INDEX[name]
+        words, reals, at, at_time = self._flight.words, self._flight.reals, flight.CALL, flight.TIME
+        busy, idle = flight.call_word(self._slot, name), flight.call_word(self._slot, "")
+
+        if name == "fmi2DoStep":  # the time too: where the FMU is, should it crash
+
+            def do_step(component: Any, t: float, h: float, last: int) -> int:
+                words[at] = busy
+                reals[at_time] = t
+                status = raw(component, t, h, last)
+                words[at] = idle
+                if status > 1:
+                    raise self._failed(name, status)
+                reals[at_time] = t + h
+                return status
+
+            return do_step
 
         def call(*args: Any) -> int:
-            record.instance = slot
-            record.call = index
+            words[at] = busy
             status = raw(*args)
-            record.call = 0
+            words[at] = idle
             if status > 1:  # fmi2Discard, fmi2Error, fmi2Fatal (as fmpy raises them)
                 raise self._failed(name, status)
             return status

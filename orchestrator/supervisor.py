@@ -62,8 +62,8 @@ def supervised(work: Callable[[], int], guard: SignalGuard) -> int:
         status = _wait(pid)
     for relay in relays:
         relay.join()
-    if record.record.finished:
-        return record.record.code
+    if record.finished:
+        return record.code
     if forwarder.killed is not None:  # the third signal: ended at once, as unsupervised
         return 128 + forwarder.killed
     return _report_crash(record, status, time.perf_counter() - started)
@@ -238,7 +238,7 @@ def crash_cause(status: int) -> str:
 def _report_crash(record: flight.Flight, status: int, wall_time: float) -> int:
     cause = crash_cause(status)
     under_way = record.call_under_way()
-    t = record.record.time
+    t = record.time
     run = record.announcement()
     if under_way is not None:
         fmu, call = under_way
