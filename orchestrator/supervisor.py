@@ -250,10 +250,10 @@ def _report_crash(record: flight.Flight, status: int, wall_time: float) -> int:
         fmu, call = None, None
         where = "the run crashed before any FMU was loaded"
     time_reached = t
-    message = f"{where} at t = {time_reached:.9g} s: {cause}"
-    if run is None:
-        print(f"error: {message}", file=sys.stderr)
+    if run is None:  # before the run began (loading the scene, building its FMUs)
+        print(f"error: the command crashed before its run began: {cause}", file=sys.stderr)
         return 1
+    message = f"{where} at t = {time_reached:.9g} s: {cause}"
     out = Path(run["output_dir"])
     summary = {
         "scene": run.get("scene"),
