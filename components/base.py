@@ -24,6 +24,7 @@ these can be checked for energy balance: stored + dissipated - external = consta
 from __future__ import annotations
 
 import copy
+import math
 import pickle
 from dataclasses import dataclass, field, replace
 from typing import Any, ClassVar, Literal
@@ -48,6 +49,10 @@ class Variable:
     #: Valid range of a parameter (inclusive, SI); None where there is no bound.
     min: float | None = None
     max: float | None = None
+    #: The lower bound is excluded: zero (say) is no valid value where it means nothing
+    #: physical (a Young's modulus, a length, an inertia).  FMI cannot say so: checked
+    #: when initialization ends (``Component.parameter_problem``).
+    exclusive_min: bool = False
     #: Of an output: the inputs it depends on directly within one instant (direct
     #: feedthrough, recomputed by ``update_outputs``).  Empty: it changes only by stepping.
     depends_on: tuple[str, ...] = ()
@@ -130,6 +135,28 @@ class Component:
             setattr(self, name, float(value))
 
     # -- life cycle -------------------------------------------------------------------
+    def parameter_problem(self) -> str | None:
+        """The first parameter that is not finite or not above an exclusive lower bound,
+        said in one line naming it; None if there is none."""
+        for v in self.VARIABLES:
+            if v.causality != "parameter":
+                continue
+            value = getattr(self, v.name)
+            if not math.isfinite(value):
+                return f"parameter {v.name} is {value!r}; expected a finite number"
+            if v.exclusive_min and v.min is not None and not value > v.min:
+                what = f" ({v.description})" if v.description else ""
+                return (
+                    f"parameter {v.name} = {value!r} {v.unit}; expected more than {v.min:g}{what}"
+                )
+        return None
+
+    def check_parameters(self) -> None:
+        """Raise ComponentError naming the first parameter ``parameter_problem`` finds."""
+        problem = self.parameter_problem()
+        if problem is not None:
+            raise ComponentError(f"{type(self).__name__}: {problem}")
+
     def initialize(self, t0: float) -> None:
         """Compute derived quantities and consistent initial outputs."""
 

@@ -71,12 +71,26 @@ class BrakeLoad(Component):
 
     VARIABLES = (
         Variable(
-            "j", "parameter", "kg.m2", APP_H_J_O5, "shaft + referred strip inertia J_o5", min=0.0
+            "j",
+            "parameter",
+            "kg.m2",
+            APP_H_J_O5,
+            "shaft + referred strip inertia J_o5",
+            min=0.0,
+            exclusive_min=True,
         ),
         Variable(
             "brake_torque", "parameter", "N.m", 160.0 * LBF_IN, "friction torque T_b", min=0.0
         ),
-        Variable("roller_radius", "parameter", "m", ROLLER_RADIUS, "feed roller radius", min=0.0),
+        Variable(
+            "roller_radius",
+            "parameter",
+            "m",
+            ROLLER_RADIUS,
+            "feed roller radius",
+            min=0.0,
+            exclusive_min=True,
+        ),
         Variable("angle0", "parameter", "rad", 0.0, "initial angle (forward positive)"),
         Variable("speed0", "parameter", "rad/s", 0.0, "initial speed"),
         Variable("torque", "input", "N.m", 0.0, "torque from the clutch (forward positive)"),

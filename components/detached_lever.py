@@ -111,7 +111,15 @@ class DetachedLever(Component):
     SNAPSHOT = SnapshotPlan()  # all its values are immutable scalars and tuples: shared
 
     VARIABLES = (
-        Variable("inertia", "parameter", "kg.m2", _I0, "balance polar inertia I", min=0.0),
+        Variable(
+            "inertia",
+            "parameter",
+            "kg.m2",
+            _I0,
+            "balance polar inertia I",
+            min=0.0,
+            exclusive_min=True,
+        ),
         Variable(
             "stiffness",
             "parameter",

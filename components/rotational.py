@@ -17,7 +17,9 @@ class Inertia(Component):
 
     SNAPSHOT = SnapshotPlan()  # scalars (and caches of parameters): shared, not pickled
     VARIABLES = (
-        Variable("J", "parameter", "kg.m2", 1.0e-3, "moment of inertia", min=0.0),
+        Variable(
+            "J", "parameter", "kg.m2", 1.0e-3, "moment of inertia", min=0.0, exclusive_min=True
+        ),
         Variable("phi0", "parameter", "rad", 0.0, "initial angle"),
         Variable("w0", "parameter", "rad/s", 0.0, "initial angular velocity"),
         Variable("tau", "input", "N.m", 0.0, "torque applied to the body"),
@@ -56,7 +58,9 @@ class SpringDamperInertia(Component):
 
     SNAPSHOT = SnapshotPlan()  # scalars (and caches of parameters): shared, not pickled
     VARIABLES = (
-        Variable("J", "parameter", "kg.m2", 1.0e-3, "moment of inertia", min=0.0),
+        Variable(
+            "J", "parameter", "kg.m2", 1.0e-3, "moment of inertia", min=0.0, exclusive_min=True
+        ),
         Variable("k", "parameter", "N.m/rad", 10.0, "torsional stiffness", min=0.0),
         Variable("d", "parameter", "N.m.s/rad", 0.01, "torsional damping", min=0.0),
         Variable(

@@ -268,9 +268,33 @@ class SpragClutch(Component):
         Variable(
             "engaged0", "parameter", "1", 1.0, "1: engaged at t0 with zero windup", min=0.0, max=1.0
         ),
-        Variable("r_outer", "parameter", "m", _S.r_outer, "outer race contact radius R_o", min=0.0),
-        Variable("r_inner", "parameter", "m", _S.r_inner, "inner race contact radius R_i", min=0.0),
-        Variable("r_sprag", "parameter", "m", _S.r_sprag, "sprag profile radius R_s", min=0.0),
+        Variable(
+            "r_outer",
+            "parameter",
+            "m",
+            _S.r_outer,
+            "outer race contact radius R_o",
+            min=0.0,
+            exclusive_min=True,
+        ),
+        Variable(
+            "r_inner",
+            "parameter",
+            "m",
+            _S.r_inner,
+            "inner race contact radius R_i",
+            min=0.0,
+            exclusive_min=True,
+        ),
+        Variable(
+            "r_sprag",
+            "parameter",
+            "m",
+            _S.r_sprag,
+            "sprag profile radius R_s",
+            min=0.0,
+            exclusive_min=True,
+        ),
         Variable(
             "sprag_offset", "parameter", "m", _S.offset, "sprag curvature-centre offset a", min=0.0
         ),
@@ -294,7 +318,13 @@ class SpragClutch(Component):
             max=0.5 * math.pi,
         ),
         Variable(
-            "youngs", "parameter", "Pa", _S.youngs, "Young's modulus (races, sprags)", min=0.0
+            "youngs",
+            "parameter",
+            "Pa",
+            _S.youngs,
+            "Young's modulus (races, sprags)",
+            min=0.0,
+            exclusive_min=True,
         ),
         Variable("poisson", "parameter", "1", _S.poisson, "Poisson ratio", min=-1.0, max=0.5),
         Variable("angle_outer", "input", "rad", 0.0, "outer race angle (forward positive)"),

@@ -320,6 +320,13 @@ class HeldTrain:
         return ()
 
 
+DEFAULT_STEP_BUDGET = 100_000  # internal steps of one doStep: about 10 s of work here
+
+
+class StepBudgetSpent(ComponentError):
+    """A doStep used up its internal step budget (VergeEscapement.max_internal_steps)."""
+
+
 class VergeCore:
     """Regime machine and right-hand sides; y = [phi_T, phi_d, psi, psi_d, W_verge].
 
@@ -343,6 +350,7 @@ class VergeCore:
         self.k = k
         self.train = train
         self.phi_off = phi_off
+        self.budget: int | None = None  # indicator evaluations left in this doStep
         self.face = face
         self.coupled = coupled
         self.psic = k.d.psic
@@ -468,6 +476,12 @@ class VergeCore:
         return [w, acc, psi_d, psi_dd, -self.k.ip * psi_d * psi_dd + cent * psi_d]
 
     def indicators(self, y: list[float]) -> tuple[float, ...]:
+        # Evaluated once per internal step tried and per event-location iteration: the
+        # count a doStep's budget is spent in.
+        if self.budget is not None:
+            self.budget -= 1
+            if self.budget < 0:
+                raise StepBudgetSpent("internal step budget spent")
         k = self.k
         sigma = self.face
         hi, lo = self.train.mesh_indicators(y[0])
@@ -792,6 +806,16 @@ class VergeEscapement(Component):
         ),
         *INTEGRATION_VARIABLES,
         Variable(
+            "max_internal_steps",
+            "parameter",
+            "1",
+            DEFAULT_STEP_BUDGET,
+            "budget of one doStep: internal integration steps and event-location iterations "
+            "(spent: the step is discarded, with a message)",
+            "Integer",
+            min=1.0,
+        ),
+        Variable(
             "center_distance",
             "parameter",
             "m",
@@ -809,6 +833,7 @@ class VergeEscapement(Component):
             M739.ip,
             "verge (pallet) moment of inertia about its pivot, I_p",
             min=0.0,
+            exclusive_min=True,
         ),
         Variable("phi", "input", "rad", 0.0, "cumulative escape-wheel angle", sampled=True),
         Variable("phi_dot", "input", "rad/s", 0.0, "escape-wheel speed", sampled=True),
@@ -950,6 +975,7 @@ class VergeEscapement(Component):
     )
 
     def initialize(self, t0: float) -> None:
+        self.check_parameters()  # a NaN spin or restitution is named here, not met later
         self._control = step_control(self, STATE_SCALES)
         self._h_next = 0.0
         data = escapement_data(self.center_distance, self.phi_local_start, self.pallet_inertia)
@@ -999,7 +1025,17 @@ class VergeEscapement(Component):
             self._g_end = core.indicators(y)
             self._outputs(y)
             return
-        done = advance(core, y, h, self._control, self._h_next)
+        core.budget = int(self.max_internal_steps)
+        try:
+            done = advance(core, y, h, self._control, self._h_next)
+        except StepBudgetSpent:
+            raise ComponentError(
+                f"VergeEscapement: doStep from t = {t:.9g} s over {h:.6g} s spent its budget of "
+                f"{int(self.max_internal_steps)} internal steps (max_internal_steps) before its "
+                "end; take shorter communication steps or give a larger budget"
+            ) from None
+        finally:
+            core.budget = None
         y, self._h_next = done.y, done.h_next
         if core.halted:
             raise ComponentError(f"VergeEscapement: {core.fault}")

@@ -153,6 +153,9 @@ class ComponentSlave(Fmi2Slave):
         ]
         if bad:
             raise self._refuse(f"initialization: not finite: {', '.join(bad)}")
+        problem = self.model.parameter_problem()
+        if problem is not None:
+            raise self._refuse(f"initialization: {problem}")
         self._not_finite.clear()
         self.model.initialize(self._start_time)
         self.model.update_outputs()

@@ -34,6 +34,12 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument(
         "--force", action="store_true", help="run even a scene of more than 1e8 macro steps"
     )
+    p.add_argument(
+        "--in-process",
+        action="store_true",
+        help="run in this process, not a supervised child: an FMU that crashes then ends "
+        "the command without a summary (for a debugger)",
+    )
     p.set_defaults(handler=_run)
 
     p = sub.add_parser("check", help="validate a scenario file without running it")
@@ -65,6 +71,9 @@ def main(argv: list[str] | None = None) -> int:
         type=Path,
         metavar="DIR",
         help="also write libcosim's OspSystemStructure.xml with the FMUs beside it into DIR",
+    )
+    p.add_argument(
+        "--force", action="store_true", help="replace an existing archive (never a scene file)"
     )
     p.set_defaults(handler=_export)
 
@@ -134,6 +143,11 @@ def main(argv: list[str] | None = None) -> int:
         "--resume", action="store_true", help="keep the samples in samples.csv, run the rest"
     )
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    p.add_argument(
+        "--keep-going",
+        action="store_true",
+        help="run every sample even when the first ones all fail with the same error",
+    )
     p.set_defaults(handler=_study)
 
     p = sub.add_parser("stability", help="run the stability suite (scenarios/stability/)")
@@ -143,7 +157,7 @@ def main(argv: list[str] | None = None) -> int:
     p.set_defaults(handler=_stability)
 
     p = sub.add_parser("bench", help="run a benchmark (prints ratios against its baseline)")
-    p.add_argument("name", choices=["overhead", "m739", "speed"])
+    p.add_argument("name", choices=["overhead", "m739", "speed", "supervision"])
     p.set_defaults(handler=_bench)
 
     p = sub.add_parser("report", help="print the summary of a finished run")
@@ -151,10 +165,15 @@ def main(argv: list[str] | None = None) -> int:
     p.set_defaults(handler=_report)
 
     args = parser.parse_args(argv)
+    return _handled(args.handler, args)
+
+
+def _handled(handler, args: argparse.Namespace) -> int:  # noqa: ANN001 - a command handler
+    """Run a command's handler; an error becomes one line and an exit code."""
     from fmus.build import BuildError  # before the try: its except clauses name it
 
     try:
-        return args.handler(args)
+        return handler(args)
     except (KeyboardInterrupt, Interrupted) as exc:
         if args.debug:
             raise
@@ -211,10 +230,19 @@ def _floats(text: str) -> tuple[float, ...]:
 
 def _run(args: argparse.Namespace) -> int:
     from orchestrator.interrupt import catching_signals
+    from orchestrator.supervisor import can_supervise, supervised
 
     # From here on SIGINT/SIGTERM only set a flag: the run stops at a step boundary.
     with catching_signals() as guard:
-        code = _run_guarded(args)
+        if args.in_process or not can_supervise():
+            code = _run_guarded(args)
+        else:
+            # The run in a child process, under this guard; a crash there is reported here.
+            def child(args: argparse.Namespace) -> int:
+                code = _run_guarded(args)
+                return 128 + guard.signum if guard.signum is not None else code
+
+            return supervised(lambda: _handled(child, args), guard)
     if guard.signum is not None:
         return 128 + guard.signum
     return code
@@ -304,6 +332,9 @@ def _export(args: argparse.Namespace) -> int:
     if args.osp is not None and args.osp.exists() and not args.osp.is_dir():
         print(f"error: --osp {args.osp}: is a file; expected a directory", file=sys.stderr)
         return 2
+    from orchestrator.export_target import check_export_target
+
+    check_export_target(args.scene, args.out, args.force)
     scene = load_scene(args.scene, _overrides(args.set))
     if args.osp is not None:  # first: it carries input signals, which SSP refuses
         print(f"{export_osp(scene, args.osp)}: the FMUs beside it")
@@ -395,7 +426,12 @@ def _study(args: argparse.Namespace) -> int:
         overrides=_overrides(args.set) or None,
         output_dir=args.output,
         show_progress=not args.no_progress,
+        keep_going=args.keep_going,
     )
+    for note in result.notes:
+        print(f"note: {note}", file=sys.stderr)
+    if result.stopped:
+        print(f"error: study {result.scene.name}: {result.stopped}", file=sys.stderr)
     ok = sum(s.status == OK for s in result.samples)
     print(
         f"study {result.scene.name}: {len(result.samples)} of {result.requested} samples, "
@@ -413,7 +449,7 @@ def _study(args: argparse.Namespace) -> int:
     print(f"results in {result.output_dir} (samples.csv, study.md, study.png)")
     if result.interrupted is not None:
         return 128 + result.interrupted
-    return 0 if ok else 1
+    return 0 if ok and not result.stopped else 1
 
 
 def _stability(args: argparse.Namespace) -> int:
@@ -445,7 +481,7 @@ def _report(args: argparse.Namespace) -> int:
     if not isinstance(summary, dict) or not isinstance(summary.get("status"), str):
         print(f"error: {summary_file} is not a run summary (no status)", file=sys.stderr)
         return 2
-    keys = ("scene", "status", "message", "time_reached", "headline", "notes", "stats")
+    keys = ("scene", "status", "message", "time_reached", "crash", "headline", "notes", "stats")
     print(json.dumps({k: summary[k] for k in keys if k in summary}, indent=2))
     return 0
 

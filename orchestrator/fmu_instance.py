@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import atexit
 import hashlib
+import itertools
 import shutil
 from collections.abc import Callable
 from ctypes import byref
@@ -20,6 +21,7 @@ from fmpy.fmi1 import FMICallException
 from fmpy.fmi2 import (  # the allocators fmpy itself hands to FMUs, and its value types
     FMU2Slave,
     calloc,
+    fmi2Boolean,
     fmi2CallbackAllocateMemoryTYPE,
     fmi2CallbackFreeMemoryTYPE,
     fmi2CallbackFunctions,
@@ -27,14 +29,66 @@ from fmpy.fmi2 import (  # the allocators fmpy itself hands to FMUs, and its val
     fmi2FMUstate,
     fmi2Integer,
     fmi2Real,
+    fmi2Terminated,
     fmi2True,
     fmi2ValueReference,
     free,
+    printLogMessage,
 )
 
+from orchestrator import flight
 from orchestrator.errors import RunError
 
 _UNPACKED: dict[str, tuple[Any, str]] = {}
+
+STATUS_NAMES = ("fmi2OK", "fmi2Warning", "fmi2Discard", "fmi2Error", "fmi2Fatal", "fmi2Pending")
+LAST_LINES = 3  # of an FMU's log, in the message of a call that failed
+
+
+DISCARD = 2
+
+
+class FmuTerminated(RunError):
+    """An FMU asked to end the simulation: the run ends there, completed."""
+
+    def __init__(self, message: str, time: float, fmu: str) -> None:
+        RuntimeError.__init__(self, message)  # the message names FMU and time itself
+        self.time, self.fmu = time, fmu
+
+
+class FmiCallError(RunError):
+    """An FMI call returned fmi2Discard, fmi2Error or fmi2Fatal."""
+
+    def __init__(self, message: str, function: str, status: int, time: float, fmu: str) -> None:
+        self.function, self.status = function, status
+        super().__init__(message, time, fmu)
+
+
+# The logger.  FMI 2.0 (2.1.5) makes its message a printf format with the arguments after
+# it, which ctypes cannot receive; fmpy's native proxy (fmpy.logging) formats them and
+# hands the text on.  The proxy keeps one logger for the process, so there is one here,
+# which passes each message to its instance by the componentEnvironment it was given.
+_LOGS: dict[int, Callable[[str], None]] = {}
+_ENVIRONMENTS = itertools.count(1)
+
+
+def _log_message(env: Any, instance: bytes, status: int, category: bytes, message: bytes) -> None:
+    keep = _LOGS.get(env or 0)
+    if keep is not None:
+        keep(message.decode("utf-8", "replace") if message else "")
+    else:  # an FMU instantiated with fmpy's default callbacks, in the same process
+        printLogMessage(env, instance, status, category, message)
+
+
+_LOGGER = fmi2CallbackLoggerTYPE(_log_message)
+
+
+def _made_by_pythonfmu(md: Any) -> bool:
+    """PythonFMU's runtime departs from FMI 2.0 in two ways that matter here: it passes a
+    log message as the printf format itself (a '%' in it is no directive), so its messages
+    are taken as they come; and after any doStep that returns False it reports
+    fmi2Terminated true, so with it a discarded step is no request to end the simulation."""
+    return (md.generationTool or "").startswith("PythonFMU")
 
 
 def _unpacked(fmu_path: str) -> tuple[Any, str]:
@@ -45,9 +99,16 @@ def _unpacked(fmu_path: str) -> tuple[Any, str]:
 
 
 @atexit.register
-def _remove_unpacked() -> None:
-    for _, directory in _UNPACKED.values():
-        shutil.rmtree(directory, ignore_errors=True)
+def _remove_unpacked(keep: frozenset[str] = frozenset()) -> None:
+    """Remove the unzip directories, but those of the FMU files in ``keep``."""
+    for fmu_path, (_, directory) in _UNPACKED.items():
+        if fmu_path not in keep:
+            shutil.rmtree(directory, ignore_errors=True)
+
+
+def unpacked_files() -> frozenset[str]:
+    """FMU files unpacked by this process so far (a forked child shares their folders)."""
+    return frozenset(_UNPACKED)
 
 
 def file_sha256(path: Path) -> str:
@@ -64,17 +125,40 @@ class FmuInstance:
         self.model_description = md
         self.variables = {v.name: v for v in md.modelVariables}
         self.messages: list[str] = []
+        self._env = next(_ENVIRONMENTS)
+        _LOGS[self._env] = self.messages.append
         self._callbacks = fmi2CallbackFunctions()
-        self._callbacks.logger = fmi2CallbackLoggerTYPE(self._log)
+        self._callbacks.logger = _LOGGER
         self._callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
         self._callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
+        self._callbacks.componentEnvironment = self._env
+        self._pythonfmu = _made_by_pythonfmu(md)
+        if not self._pythonfmu:
+            from fmpy.logging import addLoggerProxy
+
+            addLoggerProxy(byref(self._callbacks))
+        # Every FMI call is noted before it is made (orchestrator.flight): a crash inside
+        # the FMU can then be told apart and named by a supervising process.
+        self._flight = flight.current()
+        self._slot = flight.current().register(instance_name)
+        self._flight.words[flight.CALL] = flight.call_word(self._slot, flight.CALLS[1])
         self.fmu = FMU2Slave(
             guid=md.guid,
             unzipDirectory=unzip_dir,
             modelIdentifier=md.coSimulation.modelIdentifier,
             instanceName=instance_name,
         )
-        self.fmu.instantiate(callbacks=self._callbacks, loggingOn=True)
+        self._flight.words[flight.CALL] = flight.call_word(self._slot, "")
+        self.fmu._call = self._noted(self.fmu._call)
+        self._alive = self._freeable = False
+        try:
+            self.fmu.instantiate(callbacks=self._callbacks, loggingOn=True)
+        except FmiCallError:
+            raise
+        except Exception:  # fmpy: "Failed to instantiate model" for a NULL instance
+            self.fmu = None
+            said = self.last_lines() or "the FMU logged nothing"
+            raise RunError(f"fmi2Instantiate returned NULL: {said}", fmu=self.name) from None
         self._alive = True
         self._freeable = True
         # The calls of every macro step, prepared like the transfers below.
@@ -83,8 +167,21 @@ class FmuInstance:
         self._set_state = self._function("fmi2SetFMUstate")
         self._free_state = self._function("fmi2FreeFMUstate")
 
-    def _log(self, env: Any, instance: bytes, status: int, category: bytes, message: bytes) -> None:
-        self.messages.append(message.decode("utf-8", "replace") if message else "")
+    def last_lines(self, n: int = LAST_LINES) -> str:
+        """The FMU's last ``n`` log messages, oldest first."""
+        return "; ".join(m.strip() for m in self.messages[-n:] if m.strip())
+
+    def _failed(self, function: str, status: int, logged: int | None = None) -> FmiCallError:
+        """The error of an FMI call that returned ``status``: what the FMU logged during
+        it (from message ``logged``) or else its last log lines."""
+        said = self.said_since(logged) if logged is not None else ""
+        if not said:
+            last = self.last_lines()
+            said = f"its last log lines: {last}" if last else "the FMU logged nothing"
+        name = STATUS_NAMES[status] if 0 <= status < len(STATUS_NAMES) else str(status)
+        return FmiCallError(
+            f"{function} failed ({name}): {said}", function, status, self._flight.time, self.name
+        )
 
     # -- names ------------------------------------------------------------------------
     def refs(self, names: list[str] | tuple[str, ...]) -> list[int]:
@@ -96,6 +193,9 @@ class FmuInstance:
     def is_integer(self, name: str) -> bool:
         """Read and written with fmi2Get/SetInteger (Integer and Enumeration)."""
         return self.variables[name].type in ("Integer", "Enumeration")
+
+    def is_boolean(self, name: str) -> bool:
+        return self.variables[name].type == "Boolean"
 
     # -- life cycle -------------------------------------------------------------------
     def initialize(self, start: float, stop: float, values: dict[str, float]) -> None:
@@ -112,23 +212,35 @@ class FmuInstance:
                 else:
                     self.fmu.setReal(self.refs([name]), [value])
             self.fmu.exitInitializationMode()
-        except FMICallException as exc:
+        except FmiCallError as exc:
             # pythonfmu's runtime crashes on terminating or freeing an instance whose
             # initialization raised: leave it allocated (a small leak, once per failed run).
             self._alive = self._freeable = False
-            raise RunError(
-                f"initialization failed: {self.said_since(logged) or exc}", start, self.name
-            ) from None
+            said = self.said_since(logged) or f"{exc.function} returned {STATUS_NAMES[exc.status]}"
+            raise RunError(f"initialization failed: {said}", start, self.name) from None
 
     def do_step(self, t: float, h: float) -> None:
         logged = len(self.messages)
         try:
             self._do_step(self.fmu.component, t, h, fmi2True)
-        except FMICallException as exc:
+        except FmiCallError as exc:
             self._alive = False
-            raise RunError(
-                f"doStep failed: {self.said_since(logged) or exc}", t, self.name
-            ) from None
+            said = self.said_since(logged) or f"fmi2DoStep returned {STATUS_NAMES[exc.status]}"
+            if exc.status == DISCARD and self._asks_to_terminate():
+                raise FmuTerminated(
+                    f"terminated by FMU {self.name!r} at t = {t:.9g} s: {said}", t, self.name
+                ) from None
+            raise RunError(f"doStep failed: {said}", t, self.name) from None
+
+    def _asks_to_terminate(self) -> bool:
+        """fmi2GetBooleanStatus(fmi2Terminated) after a doStep that returned fmi2Discard:
+        the FMU asks to end the simulation (FMI 2.0, 4.2.3).  Not asked of PythonFMU's."""
+        if self._pythonfmu:
+            return False
+        try:
+            return self.fmu.getBooleanStatus(fmi2Terminated)
+        except RunError:  # the FMU cannot say: a plain discard
+            return False
 
     def said_since(self, index: int) -> str:
         """What the FMU logged since ``index`` (its reason first, the runtime's after)."""
@@ -147,28 +259,68 @@ class FmuInstance:
     # Prepared transfers for the hot path: the reference and value arrays are built once
     # and the FMI function is called directly (fmpy builds both arrays on every call and
     # goes through its call logger; together about half the cost of a small transfer).
+    def _noted(self, call: Callable[..., Any]) -> Callable[..., Any]:
+        """fmpy's FMI call (``FMU2Slave._call``), noted in the flight record."""
+        words, at, slot = self._flight.words, flight.CALL, self._slot
+        idle = flight.call_word(slot, "")
+
+        def noted(name: str, *args: Any) -> Any:
+            words[at] = flight.call_word(slot, name)
+            try:
+                return call(name, *args)
+            except FMICallException as exc:
+                raise self._failed(name, exc.status) from None
+            finally:
+                words[at] = idle
+
+        return noted
+
     def _function(self, name: str) -> Callable[..., int]:
         raw = self.fmu._functions[name]
+        words, reals, at, at_time = self._flight.words, self._flight.reals, flight.CALL, flight.TIME
+        busy, idle = flight.call_word(self._slot, name), flight.call_word(self._slot, "")
+
+        if name == "fmi2DoStep":  # the time too: where the FMU is, should it crash
+
+            def do_step(component: Any, t: float, h: float, last: int) -> int:
+                words[at] = busy
+                reals[at_time] = t
+                status = raw(component, t, h, last)
+                words[at] = idle
+                if status > 1:
+                    raise self._failed(name, status)
+                reals[at_time] = t + h
+                return status
+
+            return do_step
 
         def call(*args: Any) -> int:
+            words[at] = busy
             status = raw(*args)
+            words[at] = idle
             if status > 1:  # fmi2Discard, fmi2Error, fmi2Fatal (as fmpy raises them)
-                raise FMICallException(function=name, status=status)
+                raise self._failed(name, status)
             return status
 
         return call
 
-    def _transfer(self, direction: str, refs: list[int], integer: bool) -> tuple[Any, ...]:
+    def _transfer(
+        self, direction: str, refs: list[int], integer: bool, boolean: bool = False
+    ) -> tuple[Any, ...]:
         """(FMI function, instance, value references, count, value buffer) of a prepared
         fmi2Get*/fmi2Set* ``direction`` ("Get" or "Set") of ``refs``."""
         n = len(refs)
-        function = self._function(f"fmi2{direction}{'Integer' if integer else 'Real'}")
-        buf = ((fmi2Integer if integer else fmi2Real) * n)()
+        kind = "Boolean" if boolean else "Integer" if integer else "Real"
+        function = self._function(f"fmi2{direction}{kind}")
+        buf = ((fmi2Boolean if boolean else fmi2Integer if integer else fmi2Real) * n)()
         return function, self.fmu.component, (fmi2ValueReference * n)(*refs), n, buf
 
-    def getter(self, refs: list[int], integer: bool = False) -> Callable[[], list]:
-        """A function that reads the values of ``refs`` (Integer ones with ``integer``)."""
-        call, component, vr, n, buf = self._transfer("Get", refs, integer)
+    def getter(
+        self, refs: list[int], integer: bool = False, boolean: bool = False
+    ) -> Callable[[], list]:
+        """A function that reads the values of ``refs`` (Integer ones with ``integer``,
+        Boolean ones, as 0 or 1, with ``boolean``)."""
+        call, component, vr, n, buf = self._transfer("Get", refs, integer, boolean)
 
         def get() -> list:
             call(component, vr, n, buf)
@@ -208,10 +360,11 @@ class FmuInstance:
         try:
             if self._alive:
                 self.fmu.terminate()
-        except FMICallException:
+        except RunError:
             pass
         # Free the instance but keep the shared library loaded: pythonfmu's runtime embeds
         # the interpreter and does not survive being unloaded and loaded again in a process.
         if self._freeable:
             self.fmu.fmi2FreeInstance(self.fmu.component)
         self.fmu = None
+        _LOGS.pop(self._env, None)

@@ -106,6 +106,7 @@ def base_of_unit_name(unit: str) -> tuple[tuple[tuple[str, int], ...], float] | 
 def model_info(path: Path) -> ModelInfo:
     """Read an FMU file (cached per path: built FMUs are named by their content hash)."""
     path = Path(path)
+    _check_description(path, _description(path))
     try:
         md = read_model_description(str(path), validate=False)
     except Exception as exc:  # fmpy raises zip, XML and its own errors
@@ -142,6 +143,40 @@ def model_info(path: Path) -> ModelInfo:
     if annotation is not None:
         info |= _coupling(annotation, variables, md)
     return ModelInfo(**info)
+
+
+def _description(path: Path) -> ET.Element:
+    """The root of an FMU's modelDescription.xml."""
+    try:
+        with zipfile.ZipFile(path) as z:
+            return ET.fromstring(z.read("modelDescription.xml"))
+    except KeyError:
+        raise ModelInfoError(f"{path} has no modelDescription.xml: not an FMU") from None
+    except (OSError, zipfile.BadZipFile, ET.ParseError, ValueError) as exc:
+        raise ModelInfoError(f"cannot read {path} as an FMU: {exc}") from None
+
+
+def _check_description(path: Path, root: ET.Element) -> None:
+    """What must hold before fmpy reads the description: the FMI version (fmpy reads FMI
+    1.0 and 3.0 descriptions its own way, and this orchestrator calls FMI 2.0 only) and
+    unique variable names (fmpy would keep the last of two, silently)."""
+    version = root.get("fmiVersion")
+    if root.tag == "fmiModelDescription" and version is not None and version != "2.0":
+        major = version.split(".")[0]
+        label = {"1": "1.0", "3": "3.0"}.get(major, version)
+        raise ModelInfoError(
+            f"FMI {label} FMUs are not supported: {path} is FMI {version}; expected an FMI 2.0 "
+            "co-simulation FMU"
+        )
+    seen: dict[str, int] = {}
+    for i, v in enumerate(root.iterfind("ModelVariables/ScalarVariable"), start=1):
+        name = v.get("name")
+        if name in seen:
+            raise ModelInfoError(
+                f"{path}: modelDescription.xml declares the variable {name!r} twice "
+                f"(ScalarVariable {seen[name]} and {i}); variable names must be unique"
+            )
+        seen[name] = i
 
 
 def _variable(v: Any) -> VariableInfo:

@@ -47,10 +47,12 @@ class Recorder:
         self.header = ["time", *header]
         self.rows: list[list[float]] = []
         self.events: list[tuple[float, str, str, str]] = []
-        self._file = open(self.directory / "timeseries.csv", "w", newline="")  # noqa: SIM115
+        # Line-buffered: each row reaches the file as it is recorded, so a process that
+        # crashes loses at most the step under way (README, "A crashing FMU").
+        self._file = open(self.directory / "timeseries.csv", "w", newline="", buffering=1)  # noqa: SIM115
         self._writer = csv.writer(self._file)
         self._writer.writerow(self.header)
-        self._events_file = open(self.directory / "events.csv", "w", newline="")  # noqa: SIM115
+        self._events_file = open(self.directory / "events.csv", "w", newline="", buffering=1)  # noqa: SIM115
         self._events_writer = csv.writer(self._events_file)
         self._events_writer.writerow(["time", "subsystem", "from", "to"])
 

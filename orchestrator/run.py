@@ -25,7 +25,8 @@ from orchestrator.accuracy import compare
 from orchestrator.analyses import energy_residual, headline, missing_column
 from orchestrator.errors import RunError
 from orchestrator.execution import execute
-from orchestrator.fmu_instance import file_sha256
+from orchestrator.flight import announce_run
+from orchestrator.fmu_instance import FmuTerminated, file_sha256
 from orchestrator.interrupt import Interrupted, SignalGuard, catching_signals, signal_name
 from orchestrator.observers import EnergyBalance
 from orchestrator.output_lock import OutputLock
@@ -36,6 +37,7 @@ from orchestrator.scenario import Scene
 from orchestrator.scenes import ANALYSES, PLOTS, REFERENCES
 from orchestrator.scenes.family import Reference
 from orchestrator.signals import scene_signals
+from orchestrator.summary_file import not_started_summary, write_summary
 from orchestrator.system import CoupledSystem
 
 
@@ -80,6 +82,7 @@ def run_scene(
     """
     out = Path(output_dir) if output_dir else scene.output_dir
     with catching_signals() as guard, OutputLock(out):
+        announce_run(scene, out)  # for a supervisor, should this process crash
         return _run_locked(scene, out, cache_dir, show_progress, compare_reference, plots, guard)
 
 
@@ -93,7 +96,11 @@ def _run_locked(
     guard: SignalGuard,
 ) -> RunResult:
     fmu_paths = fmu_files(scene, cache_dir)
-    system = CoupledSystem(scene, fmu_paths)
+    try:
+        system = CoupledSystem(scene, fmu_paths)
+    except RunError as exc:  # an FMU that cannot be instantiated: say so in the results too
+        write_summary(out, not_started_summary(scene, str(exc)))
+        raise
     try:
         recorder = Recorder(out, system.record_header)
     except OSError as exc:
@@ -129,6 +136,10 @@ def _run_locked(
         system.initialize()
         guard.check()
         execute(system, scene, recorder, stats, progress, observers=[energy])
+    except FmuTerminated as exc:  # as FMPy does: the run ends there, with what it has
+        message = str(exc)
+        notes.append(message)
+        reached[0] = exc.time
     except RunError as exc:
         status, message = "failed", str(exc)
         if exc.time is not None:

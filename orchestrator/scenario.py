@@ -40,6 +40,9 @@ from orchestrator.signals import (
 from orchestrator.studies.study_table import StudySpec, parse_study
 from orchestrator.units import to_si
 
+#: FMI types a run can record (a Boolean as 0 or 1; a String is no number)
+RECORDED_TYPES = ("Real", "Integer", "Enumeration", "Boolean")
+
 REDUCTIONS = ("final", "initial", "max", "min", "maxabs", "mean")
 
 #: More macro steps than this cannot finish in any sensible time: refused unless forced.
@@ -271,6 +274,18 @@ class _Loader:
             raise self.fail(dotted, f"expected a string, got {node[key]!r}")
         return node[key]
 
+    def scene_name(self, name: str) -> str:
+        """A scene's name names its results directory (runs/<name>): a name, not a path."""
+        if not name.strip():
+            raise self.fail("scene.name", "empty; expected a name such as 'm739_run1'")
+        bad = [c for c in ("/", "\\", "\0") if c in name]
+        if bad or name in (".", "..") or any(ord(c) < 32 for c in name):
+            raise self.fail(
+                "scene.name",
+                f"{name!r} is not a name: no path separators, control characters, '.' or '..'",
+            )
+        return name
+
     # -- sections ---------------------------------------------------------------------
     def scene(self) -> Scene:
         raw = self.table(self.raw, "")
@@ -284,7 +299,10 @@ class _Loader:
                 raise self.fail(section, "missing section")
         head = self.table(raw["scene"], "scene")
         self.check_keys(head, "scene", {"name", "description", "start", "stop", "stop_when"})
-        name = self.string(head, "name", "scene.name")
+        name = self.scene_name(self.string(head, "name", "scene.name"))
+        description = head.get("description", "")
+        if not isinstance(description, str):
+            raise self.fail("scene.description", f"expected text, got {description!r}")
         start = self.quantity(head.get("start", 0.0), "scene.start", "s")
         if "stop" not in head:
             raise self.fail("scene.stop", "missing; expected the stop time, e.g. '0.1 s'")
@@ -309,7 +327,7 @@ class _Loader:
         return Scene(
             path=self.path,
             name=name,
-            description=head.get("description", ""),
+            description=description,
             start=start,
             stop=stop,
             fmus=fmus,
@@ -627,15 +645,20 @@ class _Loader:
                 (inst, v.name)
                 for inst, spec in fmus.items()
                 for v in spec.model.of("output")
-                if v.type in ("Real", "Integer", "Enumeration")
+                if v.type in RECORDED_TYPES
             ) + tuple((inst, n) for inst, spec in fmus.items() for n in spec.signals)
         else:
             if not isinstance(record_raw, list):
                 raise self.fail("output.record", "expected a list of '<instance>.<variable>'")
             record = tuple(self.signal(s, "output.record", fmus, None) for s in record_raw)
             for inst, var in record:
-                if fmus[inst].model.variables[var].type not in ("Real", "Integer", "Enumeration"):
-                    raise self.fail("output.record", f"{inst}.{var}: only numbers are recorded")
+                kind = fmus[inst].model.variables[var].type
+                if kind not in RECORDED_TYPES:
+                    raise self.fail(
+                        "output.record",
+                        f"{inst}.{var} is a {kind}: only {', '.join(RECORDED_TYPES)} "
+                        "variables are recorded (Booleans as 0/1)",
+                    )
         every = node.get("every", 1)
         if not isinstance(every, int) or isinstance(every, bool) or every < 1:
             raise self.fail("output.every", f"expected a positive integer, got {every!r}")

@@ -59,6 +59,7 @@ class CoupledSystem:
         # per instance: connection sources, recorded signals, and what masters watch.
         self.real_names: list[list[str]] = [[] for _ in self.names]
         self.int_names: list[list[str]] = [[] for _ in self.names]
+        self.bool_names: list[list[str]] = [[] for _ in self.names]  # recorded Booleans
         self.feeds = [_Feed([], [], [], []) for _ in self.names]
         #: per connection, (source instance, slot) of a Real source, None for an Integer one
         self.connection_sources: list[tuple[int, int] | None] = []
@@ -106,8 +107,13 @@ class CoupledSystem:
             inst.setter(f.int_refs, integer=True) if f.int_refs else None
             for inst, f in zip(self.instances, self.feeds, strict=True)
         ]
+        self._get_bools = [
+            inst.getter(inst.refs(names), boolean=True) if names else None
+            for inst, names in zip(self.instances, self.bool_names, strict=True)
+        ]
         self.values: list[list[float]] = [[] for _ in self.names]
         self.ints: list[list[int]] = [[] for _ in self.names]
+        self.bools: list[list[int]] = [[] for _ in self.names]
         self.record_header = [f"{inst}.{var}" for inst, var in scene.record]
         #: inputs that vary in time: fed around every doStep; masters land on breakpoints
         self.signals = scene_signals(scene)
@@ -117,8 +123,9 @@ class CoupledSystem:
         self._drive = self.signals.apply if self.signals else None  # hot path: no call
 
     def _slot(self, i: int, var: str) -> tuple[str, int]:
-        kind = "int" if self.instances[i].is_integer(var) else "real"
-        names = self.int_names[i] if kind == "int" else self.real_names[i]
+        inst = self.instances[i]
+        kind = "int" if inst.is_integer(var) else "bool" if inst.is_boolean(var) else "real"
+        names = {"int": self.int_names, "bool": self.bool_names, "real": self.real_names}[kind][i]
         if var not in names:
             names.append(var)
         return kind, names.index(var)
@@ -158,6 +165,9 @@ class CoupledSystem:
         get = self._get_ints[i]
         if get is not None:
             self.ints[i] = get()
+        get = self._get_bools[i]
+        if get is not None:
+            self.bools[i] = get()
 
     def read_all(self) -> None:
         for i in range(len(self.instances)):
@@ -193,7 +203,10 @@ class CoupledSystem:
     def record_row(self, t: float) -> list[float]:
         row = [t]
         for i, kind, slot in self.record_slots:
-            row.append(self.values[i][slot] if kind == "real" else self.ints[i][slot])
+            if kind == "real":
+                row.append(self.values[i][slot])
+            else:
+                row.append((self.ints if kind == "int" else self.bools)[i][slot])
         return row
 
     def stop_indicator(self) -> float | None:
@@ -228,6 +241,9 @@ class CoupledSystem:
             self.read_all()
         else:
             self.values, self.ints = list(values[0]), list(values[1])
+            for i, get in enumerate(self._get_bools):  # recorded Booleans: read again
+                if get is not None:
+                    self.bools[i] = get()
 
     def restore(self, state: list[Any]) -> None:
         """Restore every FMU without reading it (``values`` keep what was read before): for

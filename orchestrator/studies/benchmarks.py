@@ -320,8 +320,15 @@ def speed() -> None:
     print("all times measured in this run, on this machine")
 
 
+def _supervision() -> None:
+    from orchestrator.studies.supervision_cost import print_supervision_cost
+
+    print_supervision_cost()
+
+
 BENCHMARKS: dict[str, Callable[[], None]] = {
     "overhead": print_overhead,
     "m739": m739,
     "speed": speed,
+    "supervision": _supervision,
 }

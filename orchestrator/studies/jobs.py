@@ -141,8 +141,9 @@ def iter_jobs(
             except Exception as exc:  # noqa: BLE001 - reported as the job's outcome
                 yield k, exc
         return
+    # Never more processes than jobs: a fork pool starts all its workers at once.
     with ProcessPoolExecutor(
-        workers, mp_context=_pool_context(), initializer=_ignore_sigint
+        min(workers, len(jobs)), mp_context=_pool_context(), initializer=_ignore_sigint
     ) as pool:
         futures = {pool.submit(run_job, job): k for k, job in enumerate(jobs)}
         pending = set(futures)

@@ -34,7 +34,7 @@ from orchestrator.provenance import source_changed, source_commit
 from orchestrator.scenario import Scene, load_scene
 from orchestrator.studies.jobs import Job, JobResult, iter_jobs
 from orchestrator.studies.sampling import draw, unit_points
-from orchestrator.studies.study_table import StudySpec
+from orchestrator.studies.study_table import MAX_SAMPLES, StudySpec
 
 OK = "ok"  # every quantity has a value
 NOT_ARMED = "not-armed"  # the run ended without arming (the scene analysis says why)
@@ -65,6 +65,8 @@ class StudyResult:
     units: dict[str, str] = field(default_factory=dict)
     invocations: list[dict[str, Any]] = field(default_factory=list)  # runs.json: every
     # invocation of the study on this directory (samples run, wall time, where)
+    notes: list[str] = field(default_factory=list)  # what was adjusted (workers capped)
+    stopped: str | None = None  # why the study stopped early (its first samples all failed)
 
     def values(self, quantity: str) -> np.ndarray:
         """The quantity over the samples that gave every quantity (status ok)."""
@@ -109,8 +111,13 @@ def run_study(
     overrides: dict[str, Any] | None = None,
     output_dir: Path | None = None,
     show_progress: bool = True,
+    keep_going: bool = False,
 ) -> StudyResult:
-    """Run the scene's study (the missing samples only with ``resume``) and write its files."""
+    """Run the scene's study (the missing samples only with ``resume``) and write its files.
+
+    When the first ``EARLY_FAILURES`` samples run all fail with one same error (a worker
+    that cannot import the project, an FMU that cannot load), the study stops there and
+    says so, unless ``keep_going``."""
     scene_path = Path(scene_path).resolve()
     scene = load_scene(scene_path, overrides)  # builds the FMUs once, before the workers start
     spec: StudySpec | None = scene.study
@@ -119,6 +126,10 @@ def run_study(
     n = spec.samples if samples is None else samples
     if n < 1:
         raise ScenarioError("--samples", "", f"expected a positive number of samples, got {n}")
+    if n > MAX_SAMPLES:
+        raise ScenarioError(
+            "--samples", "", f"{n} is more than {MAX_SAMPLES} (the limit of [study] samples)"
+        )
     if workers is not None and workers < 1:
         raise ScenarioError(
             "--workers", "", f"expected a positive number of workers, got {workers}"
@@ -133,6 +144,13 @@ def run_study(
     else:  # drop a half-written last line and samples beyond n, keep the rest in order
         _rewrite(csv_path, spec, done)
     todo = [k for k in range(n) if k not in done]
+    notes: list[str] = []
+    if workers is not None and workers > max(1, len(todo)) and not dask_address:
+        notes.append(
+            f"--workers {workers} capped at {max(1, len(todo))}: "
+            "no more workers than samples to run"
+        )
+        workers = max(1, len(todo))
     jobs = [
         Job(
             str(scene_path),
@@ -164,8 +182,9 @@ def run_study(
     bar = ProgressBar(
         total=n, initial=len(done), unit="sample", disable=not show_progress, desc=scene.name
     )
+    early = _EarlyFailures(keep_going or len(todo) <= EARLY_FAILURES)
     with catching_signals() as guard, open(csv_path, "a", newline="") as f:
-        stop = lambda: guard.signum is not None  # noqa: E731
+        stop = lambda: guard.signum is not None or early.stopped is not None  # noqa: E731
         for j, outcome in iter_jobs(jobs, workers, dask_address, stop):
             k = todo[j]
             sample = _sample(k, points[k], outcome, spec)
@@ -175,6 +194,7 @@ def run_study(
                         units.setdefault(q, outcome.headline[q].get("unit", ""))
             if sample is None:  # interrupted: not a result; --resume runs it again
                 continue
+            early.add(sample)
             if sample.status == OK:
                 _drop_series(Path(jobs[j].output_dir))
             f.write(_csv_line(sample, spec))
@@ -199,12 +219,39 @@ def run_study(
         interrupted,
         {**_saved_units(out_dir, done, spec), **units},
         invocations,
+        notes,
+        early.stopped,
     )
     from orchestrator.studies.study_report import write_markdown, write_plot
 
     write_markdown(result, out_dir / "study.md")
     write_plot(result, out_dir / "study.png")
     return result
+
+
+EARLY_FAILURES = 4  # first samples that, failing alike, stop a study
+
+
+class _EarlyFailures:
+    """Watches the first samples of a study: all failed, with one same reason, stops it."""
+
+    def __init__(self, off: bool) -> None:
+        self.off = off
+        self.first: list[Sample] = []
+        self.stopped: str | None = None
+
+    def add(self, sample: Sample) -> None:
+        if self.off or len(self.first) >= EARLY_FAILURES:
+            return
+        self.first.append(sample)
+        if len(self.first) < EARLY_FAILURES:
+            return
+        reasons = {s.reason for s in self.first if s.status == FAILED}
+        if all(s.status == FAILED for s in self.first) and len(reasons) == 1:
+            self.stopped = (
+                f"the first {EARLY_FAILURES} samples all failed with the same error "
+                f"({reasons.pop()}): stopped; give --keep-going to run every sample"
+            )
 
 
 def _sample(k: int, inputs: np.ndarray, outcome: Any, spec: StudySpec) -> Sample | None:
@@ -268,11 +315,22 @@ def _drop_series(run_dir: Path) -> None:
 
 def _read_samples(path: Path, spec: StudySpec, points: np.ndarray) -> dict[int, Sample]:
     """Samples already recorded, checked against the study as it is drawn now."""
-    text = path.read_text()
+    try:
+        text = path.read_bytes().decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise ScenarioError(
+            path, "", f"not a text file (byte {exc.start}); run without --resume to start again"
+        ) from None
+    if "\0" in text:
+        line = text.count("\n", 0, text.index("\0")) + 1
+        raise ScenarioError(path, f"line {line}", "binary content (a NUL byte)")
     lines = text.splitlines(keepends=True)
     if lines and not lines[-1].endswith("\n"):
         lines = lines[:-1]  # cut short by a kill: run that sample again
-    rows = list(csv.reader(lines))
+    try:
+        rows = list(csv.reader(lines))
+    except csv.Error as exc:
+        raise ScenarioError(path, "", f"not a samples file: {exc}") from None
     header = csv_header(spec)
     if not rows or rows[0] != header:
         raise ScenarioError(
@@ -284,8 +342,23 @@ def _read_samples(path: Path, spec: StudySpec, points: np.ndarray) -> dict[int, 
         if len(cells) != len(header) or not cells[0].isdigit():
             raise ScenarioError(path, f"line {line}", f"expected {len(header)} fields")
         k = int(cells[0])
+        if k >= MAX_SAMPLES:
+            raise ScenarioError(
+                path,
+                f"line {line}",
+                f"sample index {k} is beyond any study ({MAX_SAMPLES} samples)",
+            )
         if k >= len(points):  # recorded by a larger study: kept, checked against its draw
             points = draw(spec, k + 1)
+        numbers = [*cells[1 : 1 + d], *cells[2 + d : 2 + d + nq]]
+        names = [*header[1 : 1 + d], *header[2 + d : 2 + d + nq]]
+        for name, cell in zip(names, numbers, strict=True):
+            try:
+                float(cell)
+            except ValueError:
+                raise ScenarioError(
+                    path, f"line {line}", f"{name} is {cell!r}, not a number"
+                ) from None
         inputs = [float(c) for c in cells[1 : 1 + d]]
         if inputs != [float(v) for v in points[k]]:
             raise ScenarioError(

@@ -98,6 +98,11 @@ TORSION_BODY_VARIABLES: tuple[tuple[str, int, str, str, str | None, str | None, 
     ("flange.tau", 9, "Real", "output", "N.m", None, "torque on the other body"),
 )
 VALUE_REFERENCES: dict[str, int] = {v[0]: v[1] for v in TORSION_BODY_VARIABLES}
+# With flags=True (TORSION_BODY_FLAGS): a Boolean and a String output.
+FLAG_VARIABLES: tuple[tuple[str, int, str, str, str | None, str | None, str], ...] = (
+    ("body.ahead", 0, "Boolean", "output", None, None, "body ahead of the flange"),
+    ("body.label", 0, "String", "output", None, None, "name of the model"),
+)
 
 # FMI base-unit exponents, written out so this fixture depends on nothing in the project.
 UNITS: dict[str, dict[str, int]] = {
@@ -157,14 +162,38 @@ def fmi_headers_dir() -> Path:
     return Path(fmpy.__file__).resolve().parent / "c-code"
 
 
-def build_torsion_body(dest: Path, can_get_set_state: bool = True, phi0_in_degrees=False) -> Path:
-    """Compile TorsionBody and pack it as ``dest/TorsionBody[-nostate][-deg].fmu``; return
-    its path.
+# Misbehaviours a TorsionBody can be built with (torsion_body.c, TORSION_BODY_FAULT).
+FAULTS = (
+    "segfault",  # doStep writes through a null pointer (SIGSEGV)
+    "abort",  # doStep calls abort() (SIGABRT)
+    "exit",  # doStep calls exit(3)
+    "get_real",  # fmi2GetReal fails (and logs why, with printf arguments)
+    "terminate",  # doStep returns fmi2Discard with fmi2Terminated true
+    "get_state",  # fmi2GetFMUstate fails
+    "instantiate",  # fmi2Instantiate returns NULL
+)
+
+
+def build_torsion_body(
+    dest: Path,
+    can_get_set_state: bool = True,
+    phi0_in_degrees: bool = False,
+    fault: str | None = None,
+    fault_time: float = 0.0,
+    flags: bool = False,
+) -> Path:
+    """Compile TorsionBody and pack it as ``dest/TorsionBody[-nostate][-deg][-<fault>].fmu``;
+    return its path.
 
     Every build gets a fresh GUID, compiled into the binary (which refuses to instantiate
     with any other) and written into the model description.  ``phi0_in_degrees``: the
-    parameter ``body.phi0`` is declared (and taken) in ``deg``, not SI.
+    parameter ``body.phi0`` is declared (and taken) in ``deg``, not SI.  ``fault``: one of
+    ``FAULTS``, from the first doStep that starts at ``fault_time`` [s] (doStep faults and
+    ``get_real``) or at once (the others).  ``flags``: with a Boolean and a String output
+    (``FLAG_VARIABLES``).
     """
+    if fault is not None and fault not in FAULTS:
+        raise ValueError(f"unknown fault {fault!r}; expected one of {FAULTS}")
     compiler = c_compiler()
     if compiler is None:
         raise ForeignFmuError("no C compiler (cc, gcc or $CC) on PATH")
@@ -173,7 +202,9 @@ def build_torsion_body(dest: Path, can_get_set_state: bool = True, phi0_in_degre
     dest.mkdir(parents=True, exist_ok=True)
     guid = "{" + str(uuid.uuid4()) + "}"
     name = MODEL_IDENTIFIER + ("" if can_get_set_state else "-nostate")
-    target = dest / (name + ("-deg" if phi0_in_degrees else "") + ".fmu")
+    name += "-deg" if phi0_in_degrees else ""
+    name += "-flags" if flags else ""
+    target = dest / (name + (f"-{fault}" if fault else "") + ".fmu")
 
     with tempfile.TemporaryDirectory(prefix="torsion_body_") as tmp:
         library = Path(tmp) / (MODEL_IDENTIFIER + suffix)
@@ -192,6 +223,15 @@ def build_torsion_body(dest: Path, can_get_set_state: bool = True, phi0_in_degre
             f'-DTORSION_BODY_GUID="{guid}"',
             *(["-DTORSION_BODY_FMU_STATE"] if can_get_set_state else []),
             *(["-DTORSION_BODY_PHI0_DEG"] if phi0_in_degrees else []),
+            *(["-DTORSION_BODY_FLAGS"] if flags else []),
+            *(
+                [
+                    f"-DTORSION_BODY_FAULT=FAULT_{fault.upper()}",
+                    f"-DTORSION_BODY_FAULT_TIME={fault_time!r}",
+                ]
+                if fault
+                else []
+            ),
             str(TORSION_BODY_SOURCE),
             "-o",
             str(library),
@@ -203,7 +243,7 @@ def build_torsion_body(dest: Path, can_get_set_state: bool = True, phi0_in_degre
                 f"compiling {TORSION_BODY_SOURCE.name} failed:\n{' '.join(command)}\n"
                 f"{result.stdout}{result.stderr}"
             )
-        xml = torsion_body_model_description(guid, can_get_set_state, phi0_in_degrees)
+        xml = torsion_body_model_description(guid, can_get_set_state, phi0_in_degrees, flags)
         partial = target.with_suffix(".fmu.part")
         with zipfile.ZipFile(partial, "w", zipfile.ZIP_DEFLATED) as z:
             z.writestr("modelDescription.xml", xml)
@@ -214,11 +254,11 @@ def build_torsion_body(dest: Path, can_get_set_state: bool = True, phi0_in_degre
 
 
 def torsion_body_model_description(
-    guid: str, can_get_set_state: bool, phi0_in_degrees: bool = False
+    guid: str, can_get_set_state: bool, phi0_in_degrees: bool = False, flags: bool = False
 ) -> bytes:
     """modelDescription.xml of TorsionBody (FMI 2.0, co-simulation)."""
     units = dict(UNITS)
-    variables = TORSION_BODY_VARIABLES
+    variables = TORSION_BODY_VARIABLES + (FLAG_VARIABLES if flags else ())
     if phi0_in_degrees:
         units["deg"] = {"rad": 1, "factor": math.pi / 180.0}
         variables = tuple((*v[:4], "deg", *v[5:]) if v[0] == "body.phi0" else v for v in variables)
@@ -270,9 +310,10 @@ def torsion_body_model_description(
         ET.SubElement(sv, type_, type_attrs)
 
     structure = ET.SubElement(root, "ModelStructure")
+    more = {"body.ahead": ("flange.phi",), "body.label": ()} if flags else {}
     for element, dependencies in (
-        ("Outputs", OUTPUT_DEPENDENCIES),
-        ("InitialUnknowns", INITIAL_DEPENDENCIES),
+        ("Outputs", OUTPUT_DEPENDENCIES | more),
+        ("InitialUnknowns", INITIAL_DEPENDENCIES | more),
     ):
         unknowns = ET.SubElement(structure, element)
         for name in sorted(dependencies, key=index.__getitem__):

@@ -15,11 +15,23 @@
  *                           they report fmi2Error (canGetAndSetFMUstate="false")
  *   TORSION_BODY_PHI0_DEG   if defined, the parameter body.phi0 is in degrees (its declared
  *                           unit "deg"), as tools that are not SI inside declare angles
+ *   TORSION_BODY_FAULT      if defined, a misbehaviour a host must survive, from the first
+ *                           doStep that starts at or after TORSION_BODY_FAULT_TIME [s]:
+ *                           FAULT_SEGFAULT, FAULT_ABORT, FAULT_EXIT (doStep writes through a
+ *                           null pointer, calls abort(), calls exit(3)), FAULT_GET_REAL
+ *                           (fmi2GetReal fails), FAULT_TERMINATE (doStep returns fmi2Discard
+ *                           and fmi2Terminated is true: the model asks to end the simulation);
+ *                           and at any time FAULT_GET_STATE (fmi2GetFMUstate fails),
+ *                           FAULT_INSTANTIATE (fmi2Instantiate returns NULL)
+ *   TORSION_BODY_FLAGS      if defined, two more outputs: the Boolean body.ahead (vr 0: the
+ *                           body's angle is ahead of the flange's) and the String body.label
+ *                           (vr 0: "TorsionBody")
  */
 
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "fmi2Functions.h"
@@ -52,7 +64,20 @@ typedef struct {
     fmi2Integer n_sub;
     fmi2Real time;
     Mode mode;
+    fmi2Boolean terminated; /* the model asked to end the simulation */
 } ModelState;
+
+/* Values of TORSION_BODY_FAULT (macros: the preprocessor compares them). */
+#define FAULT_SEGFAULT 1
+#define FAULT_ABORT 2
+#define FAULT_EXIT 3
+#define FAULT_GET_REAL 4
+#define FAULT_TERMINATE 5
+#define FAULT_GET_STATE 6
+#define FAULT_INSTANTIATE 7
+#ifndef TORSION_BODY_FAULT_TIME
+#define TORSION_BODY_FAULT_TIME 0.0
+#endif
 
 typedef struct {
     ModelState s;
@@ -110,6 +135,7 @@ static void set_start_values(Instance *inst) {
     inst->s.n_sub = 10;
     inst->s.time = 0.0;
     inst->s.mode = MODE_INSTANTIATED;
+    inst->s.terminated = fmi2False;
     update_outputs(inst);
 }
 
@@ -161,6 +187,10 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
                   fmuGUID ? fmuGUID : "(null)", TORSION_BODY_GUID);
         goto fail;
     }
+#if defined(TORSION_BODY_FAULT) && TORSION_BODY_FAULT == FAULT_INSTANTIATE
+    LOG_ERROR(inst, "cannot open the license file %s (error %d)", "torsion.lic", 2);
+    goto fail;
+#endif
 
     set_start_values(inst);
     return inst;
@@ -255,6 +285,12 @@ fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nv
     size_t i;
     if (inst == NULL) return fmi2Error;
     if (nvr > 0 && (vr == NULL || value == NULL)) return fmi2Error;
+#if defined(TORSION_BODY_FAULT) && TORSION_BODY_FAULT == FAULT_GET_REAL
+    if (inst->s.time >= TORSION_BODY_FAULT_TIME) {
+        LOG_ERROR(inst, "fmi2GetReal: sensor %s lost at t = %g s", "flange.tau", inst->s.time);
+        return fmi2Error;
+    }
+#endif
     for (i = 0; i < nvr; i++) {
         if (vr[i] >= N_REALS) {
             LOG_ERROR(inst, "fmi2GetReal: unknown value reference %u", vr[i]);
@@ -281,6 +317,42 @@ fmi2Status fmi2GetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t
     return fmi2OK;
 }
 
+#ifdef TORSION_BODY_FLAGS
+
+fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+                          fmi2Boolean value[]) {
+    Instance *inst = (Instance *)c;
+    size_t i;
+    if (inst == NULL) return fmi2Error;
+    if (nvr > 0 && (vr == NULL || value == NULL)) return fmi2Error;
+    for (i = 0; i < nvr; i++) {
+        if (vr[i] != 0) {
+            LOG_ERROR(inst, "fmi2GetBoolean: unknown value reference %u", vr[i]);
+            return fmi2Error;
+        }
+        value[i] = inst->s.r[VR_PHI] > inst->s.r[VR_PHI_IN] ? fmi2True : fmi2False;
+    }
+    return fmi2OK;
+}
+
+fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+                         fmi2String value[]) {
+    Instance *inst = (Instance *)c;
+    size_t i;
+    if (inst == NULL) return fmi2Error;
+    if (nvr > 0 && (vr == NULL || value == NULL)) return fmi2Error;
+    for (i = 0; i < nvr; i++) {
+        if (vr[i] != 0) {
+            LOG_ERROR(inst, "fmi2GetString: unknown value reference %u", vr[i]);
+            return fmi2Error;
+        }
+        value[i] = "TorsionBody";
+    }
+    return fmi2OK;
+}
+
+#else
+
 fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
                           fmi2Boolean value[]) {
     Instance *inst = (Instance *)c;
@@ -302,6 +374,8 @@ fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t 
     LOG_ERROR(inst, "TorsionBody has no String variables");
     return fmi2Error;
 }
+
+#endif
 
 fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
                        const fmi2Real value[]) {
@@ -377,6 +451,10 @@ fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *FMUstate) {
     Instance *inst = (Instance *)c;
     ModelState *copy;
     if (inst == NULL || FMUstate == NULL) return fmi2Error;
+#if defined(TORSION_BODY_FAULT) && TORSION_BODY_FAULT == FAULT_GET_STATE
+    LOG_ERROR(inst, "fmi2GetFMUstate: no memory for a snapshot of %d bytes", (int)sizeof(ModelState));
+    return fmi2Error;
+#endif
     copy = (ModelState *)*FMUstate;
     if (copy == NULL) { /* a new snapshot; an existing one is overwritten in place */
         copy = (ModelState *)inst->cb.allocateMemory(1, sizeof(ModelState));
@@ -522,6 +600,23 @@ fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint,
         LOG_ERROR(inst, "fmi2DoStep: communicationStepSize must be finite and > 0, got %g", h);
         return fmi2Error;
     }
+#if defined(TORSION_BODY_FAULT) && TORSION_BODY_FAULT <= FAULT_TERMINATE
+    if (currentCommunicationPoint >= TORSION_BODY_FAULT_TIME - 1e-12) {
+#if TORSION_BODY_FAULT == FAULT_SEGFAULT
+        volatile int *volatile nowhere = NULL;
+        *nowhere = 1;
+#elif TORSION_BODY_FAULT == FAULT_ABORT
+        abort();
+#elif TORSION_BODY_FAULT == FAULT_EXIT
+        exit(3);
+#elif TORSION_BODY_FAULT == FAULT_TERMINATE
+        inst->s.terminated = fmi2True;
+        log_message(inst, fmi2Discard, "logStatusDiscard", "end stop reached at t = %g s",
+                    currentCommunicationPoint);
+        return fmi2Discard;
+#endif
+    }
+#endif
 
     n = inst->s.n_sub;
     hs = h / n;
@@ -586,7 +681,7 @@ fmi2Status fmi2GetIntegerStatus(fmi2Component c, const fmi2StatusKind s, fmi2Int
 fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind s, fmi2Boolean *value) {
     Instance *inst = (Instance *)c;
     if (inst != NULL && s == fmi2Terminated && value != NULL) {
-        *value = fmi2False;
+        *value = inst->s.terminated;
         return fmi2OK;
     }
     return no_status();
