@@ -13,12 +13,20 @@ from orchestrator.errors import RunError, ScenarioError
 from orchestrator.interrupt import Interrupted, report_interrupted, signum_of
 
 
+class _OneLineErrors(argparse.ArgumentParser):
+    """Bad arguments end like every other bad input: one line on standard error, exit 2
+    (argparse's own ends with its usage block first)."""
+
+    def error(self, message: str):  # type: ignore[override]
+        self.exit(2, f"error: {self.prog}: {message} (see {self.prog} --help)\n")
+
+
 def main(argv: list[str] | None = None) -> int:
     """Exit codes: 0 done, 1 a run or check failed, 2 bad input (one line on standard
     error; the traceback only with --debug), 130/143 interrupted by SIGINT/SIGTERM."""
-    parser = argparse.ArgumentParser(prog="mechcosim", description=__doc__)
+    parser = _OneLineErrors(prog="mechcosim", description=__doc__)
     parser.add_argument("--debug", action="store_true", help="show the full traceback of an error")
-    sub = parser.add_subparsers(dest="command", required=True)
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=_OneLineErrors)
 
     p = sub.add_parser("run", help="run a scene and write its results")
     p.add_argument("scene", type=Path, help="scenario file (TOML)")

@@ -276,6 +276,25 @@ def test_cli_errors_are_one_line(tmp_path: Path, capsys, monkeypatch) -> None:
     _one_line_error(capsys, ["run", str(TWO)], "FMU cache", "is a file")
 
 
+@pytest.mark.parametrize(
+    "argv, fragment",
+    [
+        (["check", "x.toml", "--set", "-x=1"], "--set: expected one argument"),
+        (["frobnicate"], "invalid choice"),
+        (["run"], "required: scene"),
+        (["bench", "nonsense"], "invalid choice"),
+    ],
+)
+def test_bad_arguments_are_one_line_too(capsys, argv: list[str], fragment: str) -> None:
+    """argparse's own refusals end like every bad input: one line, exit 2."""
+    with pytest.raises(SystemExit) as stop:
+        main(argv)
+    assert stop.value.code == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: ") and err.count("\n") == 1, err
+    assert fragment in err and "--help" in err, err
+
+
 def test_debug_shows_the_traceback(tmp_path: Path) -> None:
     with pytest.raises(ScenarioError):
         main(["--debug", "check", str(tmp_path / "missing.toml")])
