@@ -273,21 +273,21 @@ def _check(args: argparse.Namespace) -> int:
 
 def _build(args: argparse.Namespace) -> int:
     from fmus.build import build_fmu
-    from fmus.registry import FMU_WRAPPERS
+    from fmus.registry import FMU_RECORDS
     from orchestrator.cache import check_cache_dir
 
     check_cache_dir(args.dest)
-    for name in args.names or sorted(FMU_WRAPPERS):
+    for name in args.names or sorted(FMU_RECORDS):
         print(build_fmu(name, args.dest, force=args.force))
     return 0
 
 
 def _validate(args: argparse.Namespace) -> int:
-    from fmus.registry import FMU_WRAPPERS
+    from fmus.registry import FMU_RECORDS
     from orchestrator.fmu_checks import check_fmu
 
     failures = 0
-    for name in args.names or sorted(FMU_WRAPPERS):
+    for name in args.names or sorted(FMU_RECORDS):
         problems = check_fmu(name)
         print(f"{name}: {'ok' if not problems else 'FAILED'}")
         for problem in problems:

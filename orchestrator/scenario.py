@@ -15,7 +15,8 @@ from typing import Any
 
 from components.base import Component
 from fmus.build import BuildError, build_fmu
-from fmus.registry import FMU_WRAPPERS
+from fmus.ports import PortError, PortSide, join_ports
+from fmus.registry import FMU_RECORDS
 from orchestrator.errors import ScenarioError
 from orchestrator.master_settings import (
     ALGORITHMS,
@@ -134,11 +135,7 @@ class Scene:
         component = self.fmus[instance].component
         if component is None:
             raise ValueError(f"FMU instance {instance!r} is not one of this project's components")
-        return component_class(component)
-
-
-def component_class(fmu_name: str) -> type[Component]:
-    return FMU_WRAPPERS[fmu_name].component_class()
+        return FMU_RECORDS[component].component_class
 
 
 def load_scene(
@@ -382,7 +379,7 @@ class _Loader:
         if ("component" in entry) == ("fmu" in entry):
             raise self.fail(
                 key,
-                f"expected exactly one of 'component' (one of {sorted(FMU_WRAPPERS)}) or "
+                f"expected exactly one of 'component' (one of {sorted(FMU_RECORDS)}) or "
                 "'fmu' (the path of an FMI 2.0 co-simulation FMU, relative to the scene file)",
             )
         if "fmu" in entry:
@@ -392,10 +389,10 @@ class _Loader:
                 raise self.fail(f"{key}.fmu", f"no FMU file at {path}")
             return None, path
         component = self.string(entry, "component", f"{key}.component")
-        if component not in FMU_WRAPPERS:
+        if component not in FMU_RECORDS:
             raise self.fail(
                 f"{key}.component",
-                f"unknown {component!r}; expected one of {sorted(FMU_WRAPPERS)}",
+                f"unknown {component!r}; expected one of {sorted(FMU_RECORDS)}",
             )
         try:
             return component, build_fmu(component, self.cache_dir)
@@ -504,23 +501,15 @@ class _Loader:
             if name not in model.ports:
                 known = sorted(model.ports) or "none: it declares no ports, connect variables"
                 raise self.fail(key, f"{instance!r} has no port {name!r}; expected one of {known}")
-            sides.append((instance, model, model.ports[name]))
-        (ia, ma, pa), (ib, mb, pb) = sides
-        roles = sorted(set(pa) & set(pb))
-        if not roles:
-            raise self.fail(key, f"ports {ports} share no role (angle, speed, torque, ...)")
-        out = []
-        for role in roles:
-            va, vb = ma.variables[pa[role]], mb.variables[pb[role]]
-            if va.causality == "output" and vb.causality == "input":
-                out.append(Connection((ia, va.name), (ib, vb.name)))
-            elif vb.causality == "output" and va.causality == "input":
-                out.append(Connection((ib, vb.name), (ia, va.name)))
-            else:
-                raise self.fail(
-                    key, f"role {role!r}: one side must output it and the other take it as input"
-                )
-        return out
+            variables = model.variables
+            sides.append(
+                PortSide(instance, name, model.ports[name], lambda v, vs=variables: vs[v].causality)
+            )
+        try:
+            links = join_ports(*sides)
+        except PortError as exc:
+            raise self.fail(key, str(exc)) from None
+        return [Connection(link.source, link.target) for link in links]
 
     def check_connection(self, c: Connection, fmus: dict[str, FmuSpec], key: str) -> None:
         """Types must match (Real to Real, Integer or Enumeration to either) and units agree
