@@ -38,7 +38,7 @@ from orchestrator.scenes.family import Reference
 from orchestrator.system import CoupledSystem
 
 
-@dataclass
+@dataclass(kw_only=True)
 class RunResult:
     scene: Scene
     status: str  # "completed", "failed" or "interrupted"
@@ -159,8 +159,6 @@ def _run_locked(
     if guard.signum is not None and status == "completed":
         status = "interrupted"
         message = f"interrupted by {signal_name(guard.signum)} after the run ended"
-    if notes:
-        stats.extra.setdefault("warnings", []).extend(notes)
     recorder.close(
         {
             "scene": scene.name,
@@ -175,21 +173,21 @@ def _run_locked(
         }
     )
     return RunResult(
-        scene,
-        status,
-        message,
-        recorder.header,
-        data,
-        recorder.events,
-        stats,
-        quantities,
-        out,
-        accuracy,
-        meta,
-        reached[0],
-        notes,
-        guard.signum if status == "interrupted" else None,
-        ref,
+        scene=scene,
+        status=status,
+        message=message,
+        header=recorder.header,
+        data=data,
+        events=recorder.events,
+        stats=stats,
+        headline=quantities,
+        output_dir=out,
+        accuracy=accuracy,
+        metadata=meta,
+        time_reached=reached[0],
+        notes=notes,
+        interrupted_by=guard.signum if status == "interrupted" else None,
+        reference=ref,
     )
 
 

@@ -136,6 +136,7 @@ def test_press_feed_shorter_than_a_cycle_says_what_is_missing(tmp_path: Path) ->
     assert any("less than one crank cycle" in n for n in result.notes), result.notes
     summary = json.loads((tmp_path / "summary.json").read_text())
     assert "energy_residual" in summary["headline"] and summary["notes"] == result.notes
+    assert "warnings" not in summary["stats"]  # the notes once, not again as the master's
 
 
 def test_m739_without_spin_has_no_reference_trajectory_but_ends(tmp_path: Path) -> None:
