@@ -547,12 +547,6 @@ class _Loader:
             raise self.fail("master.step", f"must be positive, got {step} s")
         if step > duration:
             raise self.fail("master.step", f"{step} s is longer than the run ({duration} s)")
-        if duration / step > MAX_STEPS and algorithm != "regime-aware" and not self.force:
-            raise self.fail(
-                "master.step",
-                f"{step:g} s over {duration:g} s is {duration / step:.3g} macro steps, more "
-                f"than the limit {MAX_STEPS:.0e}: the run would not finish (--force to run it)",
-            )
         order = node.get("order", list(fmus))
         if not (
             isinstance(order, list)
@@ -565,7 +559,13 @@ class _Loader:
             settings = master_settings(algorithm, step, duration, options)
         except SettingError as exc:
             raise self.fail(f"master.{exc.key}", str(exc)) from None
-        largest = getattr(settings, "max_step", None)
+        largest = getattr(settings, "max_step", None)  # a master that varies its step
+        if largest is None and duration / step > MAX_STEPS and not self.force:
+            raise self.fail(
+                "master.step",
+                f"{step:g} s over {duration:g} s is {duration / step:.3g} macro steps, more "
+                f"than the limit {MAX_STEPS:.0e}: the run would not finish (--force to run it)",
+            )
         if largest is not None:
             if duration / largest > MAX_STEPS and not self.force:
                 raise self.fail(

@@ -1,7 +1,23 @@
 """The M739 S&A: involute gear train and straight-sided verge runaway escapement (Lowen &
 Tepper 1982, *Computer Simulation of Artillery S&A Mechanism*)."""
 
-from orchestrator.scenes.family import SceneFamily, escapement_needs
+from orchestrator.scenes.family import Needs, Option, Role, SceneFamily
+
+_ESCAPEMENT_FORCES = ("phi", "phi_dot", "regime", "F12", "F23", "FF12", "FF23")
+_VERGE = ("regime", "PN", "impact_count")
+
+
+def escapement_needs(train_component: str) -> Needs:
+    """What a spin-driven train + verge escapement family reads: the train's angle, speed,
+    regime and mesh forces, the verge's regime, normal force and impact count."""
+    return Needs(
+        options=(Option("train"), Option("verge")),
+        roles=(
+            Role(train_component, "train", "train", _ESCAPEMENT_FORCES),
+            Role("VergeEscapement", "verge", "verge", _VERGE),
+        ),
+    )
+
 
 FAMILY = SceneFamily(
     needs=escapement_needs("GearTrain"),
