@@ -28,8 +28,8 @@ from orchestrator.master_settings import (
     read_options,
 )
 from orchestrator.model_info import ModelInfo, ModelInfoError, VariableInfo, model_info
-from orchestrator.scenes import ANALYSES, REFERENCES, family
-from orchestrator.scenes.family import Option
+from orchestrator.scenes import ANALYSES, REFERENCES, family, shared_parameters
+from orchestrator.scenes.family import Option, SharedParameter
 from orchestrator.studies.study_table import StudySpec, parse_study
 from orchestrator.units import to_si
 
@@ -37,13 +37,6 @@ REDUCTIONS = ("final", "initial", "max", "min", "maxabs", "mean")
 
 #: More macro steps than this cannot finish in any sensible time: refused unless forced.
 MAX_STEPS = 1e8
-
-#: Parameters that mean one physical quantity wherever they appear: when a scene holds
-#: several of these components, their values of the parameter must agree.  Keyed by our
-#: components' names (fmus.registry), so it holds for every scene of the family.
-SHARED_PARAMETERS: tuple[tuple[str, frozenset[str], str], ...] = (
-    ("spin", frozenset({"GearTrain", "ClockGearTrain", "VergeEscapement"}), "the fuze spin rate"),
-)
 
 
 @dataclass(frozen=True)
@@ -264,7 +257,17 @@ class _Loader:
         self.check_keys(
             raw,
             "",
-            {"scene", "fmus", "connections", "master", "output", "report", "sweep", "study"},
+            {
+                "scene",
+                "parameters",
+                "fmus",
+                "connections",
+                "master",
+                "output",
+                "report",
+                "sweep",
+                "study",
+            },
         )
         for section in ("scene", "fmus", "master"):
             if section not in raw:
@@ -278,8 +281,8 @@ class _Loader:
         stop = self.quantity(head["stop"], "scene.stop", "s")
         if not stop > start:
             raise self.fail("scene.stop", f"must be later than scene.start ({start} s), got {stop}")
-        fmus = self.fmus(self.table(raw["fmus"], "fmus"))
-        self.shared_parameters(fmus)
+        shared = self.table(raw.get("parameters", {}), "parameters")
+        fmus = self.fmus(self.table(raw["fmus"], "fmus"), shared)
         stop_when = self.stop_when(head["stop_when"], fmus) if "stop_when" in head else None
         connections = self.connections(raw.get("connections", []), fmus)
         master = self.master(self.table(raw["master"], "master"), fmus, stop - start)
@@ -313,30 +316,6 @@ class _Loader:
             study=study,
         )
 
-    def shared_parameters(self, fmus: dict[str, FmuSpec]) -> None:
-        """Parameters that are one quantity across components (SHARED_PARAMETERS) agree."""
-        for name, components, meaning in SHARED_PARAMETERS:
-            values = []
-            for instance, spec in fmus.items():
-                if spec.component not in components:
-                    continue
-                var = spec.model.variables.get(name)
-                if var is None or var.causality != "parameter":
-                    continue
-                try:
-                    value = float(spec.parameters.get(name, var.start))
-                except (TypeError, ValueError):
-                    continue
-                values.append((instance, value, var.unit or ""))
-            for instance, value, unit in values[1:]:
-                first, v0, _ = values[0]
-                if not math.isclose(value, v0, rel_tol=1e-9, abs_tol=1e-12):
-                    raise self.fail(
-                        f"fmus.{instance}.parameters.{name}",
-                        f"{value:.9g} {unit} differs from {first}'s {v0:.9g} {unit}: "
-                        f"{name} is {meaning}, one value for every FMU of the scene",
-                    )
-
     def stop_when(self, node: Any, fmus: dict[str, FmuSpec]) -> StopCondition:
         key = "scene.stop_when"
         node = self.table(node, key)
@@ -353,7 +332,8 @@ class _Loader:
         threshold = self.quantity(node[side], f"{key}.{side}", var.unit or "1")
         return StopCondition(signal, threshold, rising=side == "above")
 
-    def fmus(self, node: dict[str, Any]) -> dict[str, FmuSpec]:
+    def fmus(self, node: dict[str, Any], shared: dict[str, Any]) -> dict[str, FmuSpec]:
+        """The [fmus.<instance>] tables, each given the [parameters] its component shares."""
         if not node:
             raise self.fail("fmus", "no FMU given; expected at least one [fmus.<instance>] table")
         specs = {}
@@ -369,10 +349,61 @@ class _Loader:
             except ModelInfoError as exc:
                 raise self.fail(f"{key}.fmu", str(exc)) from None
             params = self.values(entry.get("parameters", {}), f"{key}.parameters", model)
+            for name, value in shared.items():
+                if _takes(component, model, shared_parameters().get(name)):
+                    params[name] = self.value(value, f"parameters.{name}", model.variables[name])
             inputs = self.values(entry.get("inputs", {}), f"{key}.inputs", model)
             name = component or model.model_name
             specs[instance] = FmuSpec(instance, name, path, model, params, inputs, component)
+        self.check_shared(node, shared, specs)
         return specs
+
+    def check_shared(
+        self, node: dict[str, Any], shared: dict[str, Any], fmus: dict[str, FmuSpec]
+    ) -> None:
+        """A shared parameter is stated once, in [parameters], and some FMU takes it."""
+        taken = {
+            p.name: p
+            for p in shared_parameters().values()
+            for spec in fmus.values()
+            if _takes(spec.component, spec.model, p)
+        }
+        for instance, entry in node.items():
+            for name in entry.get("parameters", {}):
+                if name in taken and _takes(
+                    fmus[instance].component, fmus[instance].model, taken[name]
+                ):
+                    raise self.fail(
+                        f"fmus.{instance}.parameters.{name}",
+                        f"{name} is {taken[name].meaning}, shared by "
+                        f"{', '.join(sorted(taken[name].components))}: state it once for the "
+                        f"scene as parameters.{name} (a [parameters] table)",
+                    )
+        for name in shared:
+            if name not in taken:
+                raise self.fail(
+                    f"parameters.{name}",
+                    "not a parameter the scene's FMUs share (set it in [fmus.<instance>] "
+                    f"parameters); expected one of {sorted(taken)}"
+                    if taken
+                    else "no FMU of the scene shares a parameter: set it in "
+                    "[fmus.<instance>] parameters",
+                )
+
+    def key_variables(self, dotted: str, fmus: dict[str, FmuSpec]) -> list[tuple[str, str, str]]:
+        """The FMU variables a dotted key sets, as (instance, "parameters" or "inputs",
+        variable); [] for a key that sets none (master.*, scene.*)."""
+        parts = _split_key(dotted)
+        if len(parts) == 4 and parts[0] == "fmus" and parts[2] in ("parameters", "inputs"):
+            return [(parts[1], parts[2], parts[3])]
+        if len(parts) == 2 and parts[0] == "parameters":
+            shared = shared_parameters().get(parts[1])
+            return [
+                (instance, "parameters", parts[1])
+                for instance, spec in fmus.items()
+                if _takes(spec.component, spec.model, shared)
+            ]
+        return []
 
     def fmu_file(self, entry: dict[str, Any], key: str) -> tuple[str | None, Path]:
         """(registry name or None, FMU file) of one [fmus.<instance>] table."""
@@ -757,6 +788,12 @@ class _Loader:
             if var is None or var.causality != causality:
                 raise self.fail(key, f"{fmus[instance].fmu} has no {causality} {name!r}")
             return var.unit or "1"
+        if len(parts) == 2 and parts[0] == "parameters":
+            targets = self.key_variables(dotted, fmus)
+            if not targets:
+                raise self.fail(key, f"no FMU of the scene shares a parameter {parts[1]!r}")
+            instance, _, name = targets[0]
+            return fmus[instance].model.variables[name].unit or "1"
         if len(parts) == 2 and parts[0] == "master" and parts[1] in SETTING_KINDS:
             if SETTING_KINDS[parts[1]].choices:
                 raise self.fail(key, f"cannot sweep {dotted!r}: it is a word, not a number")
@@ -768,10 +805,19 @@ class _Loader:
         raise self.fail(
             key,
             f"cannot sweep {dotted!r}; expected fmus.<instance>.parameters.<name>, "
-            "fmus.<instance>.inputs.<name>, master.<setting> or scene.start/stop",
+            "fmus.<instance>.inputs.<name>, parameters.<shared name>, master.<setting> or "
+            "scene.start/stop",
         )
 
     def number(self, value: Any, k: int) -> float:
         if isinstance(value, bool) or not isinstance(value, int | float):
             raise self.fail(f"sweep.values[{k}]", f"expected a number, got {value!r}")
         return float(value)
+
+
+def _takes(component: str | None, model: ModelInfo, shared: SharedParameter | None) -> bool:
+    """Whether one of our FMUs (``component``) takes a shared parameter."""
+    if shared is None or component not in shared.components:
+        return False
+    var = model.variables.get(shared.name)
+    return var is not None and var.causality == "parameter"

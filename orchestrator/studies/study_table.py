@@ -38,6 +38,10 @@ class SceneChecks(Protocol):
         """The SI unit of a key a study may set (None: a plain value)."""
         ...
 
+    def key_variables(self, dotted: str, fmus: dict[str, Any]) -> list[tuple[str, str, str]]:
+        """The (instance, "parameters" or "inputs", variable) a key sets."""
+        ...
+
 
 SAMPLING_METHODS = ("sobol", "monte-carlo")
 DISTRIBUTIONS = ("band", "normal", "uniform", "lognormal", "discrete")
@@ -308,11 +312,10 @@ def _band(loader: SceneChecks, text: Any, key: str, unit: str, nominal: float) -
 
 def _scene_value(loader: SceneChecks, key: str, fmus: dict[str, Any], where: str) -> float:
     """The scene's own value of an FMU parameter or input (the nominal of a band)."""
-    parts = key.split(".", 3)
-    if len(parts) == 4 and parts[0] == "fmus" and parts[1] in fmus:
-        spec = fmus[parts[1]]
-        given = spec.parameters if parts[2] == "parameters" else spec.inputs
-        value = given.get(parts[3], spec.model.variables[parts[3]].start)
+    for instance, kind, name in loader.key_variables(key, fmus)[:1]:
+        spec = fmus[instance]
+        given = spec.parameters if kind == "parameters" else spec.inputs
+        value = given.get(name, spec.model.variables[name].start)
         try:
             return float(value)
         except (TypeError, ValueError):
@@ -326,11 +329,9 @@ def _check_range(loader: SceneChecks, spec: StudyInput, where: str, fmus: dict[s
     """A distribution bounded on a side stays within the range the FMU declares there (an
     unbounded one may reach past it: those samples fail, and are counted, at run time)."""
     low, high = spec.support
-    for key in spec.keys:
-        parts = key.split(".", 3)
-        if len(parts) != 4 or parts[0] != "fmus":
-            continue
-        var = fmus[parts[1]].model.variables[parts[3]]
+    targets = [(key, *target) for key in spec.keys for target in loader.key_variables(key, fmus)]
+    for key, instance, _, name in targets:
+        var = fmus[instance].model.variables[name]
         if var.min is not None and math.isfinite(low) and low < var.min:
             raise loader.fail(
                 where, f"reaches {low:.6g} {spec.unit}, below {key}'s minimum {var.min:g}"

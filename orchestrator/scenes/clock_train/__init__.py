@@ -5,10 +5,11 @@ fuze report of about 1980 (Task 2).
 """
 
 from orchestrator.scenes.family import SceneFamily
-from orchestrator.scenes.m739 import escapement_needs
+from orchestrator.scenes.m739 import escapement_needs, escapement_shared
 
 FAMILY = SceneFamily(
     needs=escapement_needs("ClockGearTrain"),
+    shared=escapement_shared("ClockGearTrain"),
     analysis="orchestrator.scenes.clock_train.report:analyse",
     plot="orchestrator.scenes.clock_train.report:plot",
     reference="orchestrator.scenes.clock_train.report:reference",
