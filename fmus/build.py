@@ -100,12 +100,15 @@ def build_fmu(name: str, cache_dir: Path | None = None, force: bool = False) -> 
         raise BuildError(f"cannot use {cache_dir} as the FMU cache: {exc}") from None
     try:
         digest = content_hash(record)[:16]
-        needs = record.requirements()
-    except (RecordError, ExampleSceneError) as exc:
+    except ExampleSceneError as exc:
         raise BuildError(str(exc)) from None
     target = cache_dir / f"{name}-{digest}.fmu"
     if target.exists() and not force:
         return target
+    try:
+        needs = record.requirements()
+    except RecordError as exc:
+        raise BuildError(str(exc)) from None
     with tempfile.TemporaryDirectory(prefix="mechcosim_build_") as tmp:
         built = _build(record, digest, needs, Path(tmp))
         # A name of its own per builder, then an atomic rename: parallel builds of one FMU
