@@ -312,10 +312,6 @@ class ClockTrainPhysics:
         """Rotor angle Phi (the M739's, phi1c at phi = 0) [rad]."""
         return self.phi1c + self.evaluate(phi)[0] - self.theta1_0
 
-    def drive_moment(self, phi: float) -> float:
-        """Spin moment on the eccentric rotor, M1 = -A35 sin(Phi) [N.m]."""
-        return -self.a35 * math.sin(self.rotor_angle(phi))
-
     def j_stot(self, phi: float) -> float:
         """Frictionless reflected inertia I3 + I2 r2^2 + I1 r1^2 [kg.m2]."""
         ev = self.evaluate(phi)

@@ -70,7 +70,6 @@ from .mesh_efficiency import (
 from .mesh_efficiency_data import ALFIN_ANOMALY_TABLES, INVOLUTE_MESHES, PRINTED_RUNS
 
 MODEL_IDEAL, MODEL_INVOLUTE, MODEL_CLOCK = 0, 1, 2
-MODEL_NAMES = {MODEL_IDEAL: "ideal", MODEL_INVOLUTE: "involute", MODEL_CLOCK: "clock"}
 
 # Contact phases.  Dual contact: trailing pair, leading pair.
 SINGLE_APPROACH, SINGLE_RECESS = 0, 1

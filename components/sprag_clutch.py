@@ -203,14 +203,6 @@ def sprag_inertia_terms(s: SpragGeometry = TABLE4) -> tuple[float, float, float,
     )
 
 
-def windup_integral(ratio: float, n: float = N_DAMP) -> float:
-    """Footnote 8 integral of (X/delta sin tau + 1)^n cos^2 tau over one period."""
-    x, wt = np.polynomial.legendre.leggauss(200)
-    tau = math.pi * (x + 1.0)
-    f = np.maximum(ratio * np.sin(tau) + 1.0, 0.0) ** n * np.cos(tau) ** 2
-    return float(math.pi * np.sum(wt * f))
-
-
 # -- the component ---------------------------------------------------------------------------
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(8)
 _GL_X, _GL_W = tuple(0.5 * (_GL_X + 1.0)), tuple(0.5 * _GL_W)

@@ -15,7 +15,6 @@ entries carry a fixed date: the same sources and build environment give the same
 
 from __future__ import annotations
 
-import ast
 import hashlib
 import os
 import re
@@ -24,7 +23,6 @@ import sys
 import tempfile
 import uuid
 import zipfile
-from functools import cache
 from pathlib import Path
 from xml.dom.minidom import parseString
 from xml.etree import ElementTree as ET
@@ -35,27 +33,28 @@ from pythonfmu.builder import FmuBuilder
 from components.base import Component
 from fmus.description import complete_description
 from fmus.documentation import render_documentation
+from fmus.example_scenes import ExampleSceneError
 from fmus.host_loader import LOADER_SOURCE, loader_binary, loader_plan, pack_loader
-from fmus.registry import FMU_WRAPPERS, FmuWrapper
+from fmus.registry import FMU_RECORDS, FmuRecord, RecordError
 
 FMUS_DIR = Path(__file__).resolve().parent
 PROJECT_DIR = FMUS_DIR.parent
-COMPONENTS_DIR = PROJECT_DIR / "components"
 SLAVE_MODULE = FMUS_DIR / "component_slave.py"
 #: Code that shapes every FMU: a change to any of it is a new build.
 BUILD_CODE = (
     SLAVE_MODULE,
     Path(__file__),
+    FMUS_DIR / "registry.py",
     FMUS_DIR / "description.py",
     FMUS_DIR / "documentation.py",
+    FMUS_DIR / "example_scenes.py",
+    FMUS_DIR / "ports.py",
     FMUS_DIR / "units.py",
     FMUS_DIR / "host_loader.py",
     LOADER_SOURCE,
 )
 #: the date of every entry of an FMU archive (the earliest a zip file can hold)
 ZIP_DATE = (1980, 1, 1, 0, 0, 0)
-#: Requirement lines for the third-party modules component code may import.
-REQUIREMENTS = {"numpy": "numpy>=1.26", "scipy": "scipy>=1.11"}
 
 
 class BuildError(RuntimeError):
@@ -71,61 +70,18 @@ def default_cache_dir() -> Path:
     return base / "mechcosim" / "fmus"
 
 
-def component_modules(wrapper: FmuWrapper) -> list[Path]:
-    """The modules of ``components`` the wrapper's component imports, itself included."""
-    start = COMPONENTS_DIR / f"{wrapper.component.split('.')[1]}.py"
-    found: list[Path] = [COMPONENTS_DIR / "__init__.py"]
-    todo = [start]
-    while todo:
-        module = todo.pop()
-        if module in found:
-            continue
-        found.append(module)
-        stat = module.stat()
-        for name in _relative_imports(module, stat.st_mtime_ns, stat.st_size):
-            todo.append(COMPONENTS_DIR / f"{name}.py")
-    return sorted(found)
-
-
-@cache
-def _relative_imports(module: Path, mtime_ns: int, size: int) -> tuple[str, ...]:
-    """The modules ``module`` imports as ``from .name import``.  Kept per file version (its
-    modification time and size), so an edit is seen: parsing every module again on every
-    scene load cost 0.12 s a load, 10 s of an 80-sample study."""
-    return tuple(
-        node.module
-        for node in ast.walk(ast.parse(module.read_text()))
-        if isinstance(node, ast.ImportFrom) and node.level == 1 and node.module
-    )
-
-
-def requirements(modules: list[Path]) -> list[str]:
-    """Requirement lines for the third-party modules that ``modules`` import."""
-    names: set[str] = set()
-    for module in modules:
-        for node in ast.walk(ast.parse(module.read_text())):
-            if isinstance(node, ast.Import):
-                names.update(a.name.split(".")[0] for a in node.names)
-            elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
-                names.add(node.module.split(".")[0])
-    third_party = sorted(names - set(sys.stdlib_module_names) - {"__future__"})
-    unknown = [n for n in third_party if n not in REQUIREMENTS]
-    if unknown:
-        raise BuildError(f"components import {unknown}: add them to fmus.build.REQUIREMENTS")
-    return [REQUIREMENTS[n] for n in third_party]
-
-
-def content_hash(wrapper: FmuWrapper) -> str:
-    """Hash of everything that ends up in the FMU (its code, build code, pythonfmu)."""
+def content_hash(record: FmuRecord) -> str:
+    """Hash of everything that ends up in the FMU: its code and declarations, the build
+    code, pythonfmu, and how the example scenes couple it (not their values)."""
     h = hashlib.sha256()
-    for f in component_modules(wrapper):
+    for f in record.modules():
         h.update(f"components/{f.name}".encode())
         h.update(f.read_bytes())
-    for f in [wrapper.script, *BUILD_CODE]:
+    for f in [record.script, *BUILD_CODE]:
         h.update(str(f.relative_to(PROJECT_DIR)).encode())
         h.update(f.read_bytes())
-    for example in wrapper.examples:  # the documentation lists their connections
-        h.update((PROJECT_DIR / example).read_bytes())
+    for example in record.examples():  # the documentation lists their connections
+        h.update(example.identity().encode())
     h.update(pythonfmu.__version__.encode())
     h.update(loader_plan().identity.encode())  # the compiler and the Python it names
     return h.hexdigest()
@@ -134,20 +90,27 @@ def content_hash(wrapper: FmuWrapper) -> str:
 def build_fmu(name: str, cache_dir: Path | None = None, force: bool = False) -> Path:
     """Return the path of the FMU for component ``name``, building it if not cached."""
     try:
-        wrapper = FMU_WRAPPERS[name]
+        record = FMU_RECORDS[name]
     except KeyError:
-        raise BuildError(f"no FMU named {name!r}; known: {sorted(FMU_WRAPPERS)}") from None
+        raise BuildError(f"no FMU named {name!r}; known: {sorted(FMU_RECORDS)}") from None
     cache_dir = Path(cache_dir) if cache_dir else default_cache_dir()
     try:
         cache_dir.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise BuildError(f"cannot use {cache_dir} as the FMU cache: {exc}") from None
-    digest = content_hash(wrapper)[:16]
+    try:
+        digest = content_hash(record)[:16]
+    except ExampleSceneError as exc:
+        raise BuildError(str(exc)) from None
     target = cache_dir / f"{name}-{digest}.fmu"
     if target.exists() and not force:
         return target
+    try:
+        needs = record.requirements()
+    except RecordError as exc:
+        raise BuildError(str(exc)) from None
     with tempfile.TemporaryDirectory(prefix="mechcosim_build_") as tmp:
-        built = _build(wrapper, digest, Path(tmp))
+        built = _build(record, digest, needs, Path(tmp))
         # A name of its own per builder, then an atomic rename: parallel builds of one FMU
         # never see half a file or each other's part.
         try:
@@ -160,19 +123,14 @@ def build_fmu(name: str, cache_dir: Path | None = None, force: bool = False) -> 
     return target
 
 
-def build_all(cache_dir: Path | None = None, force: bool = False) -> dict[str, Path]:
-    return {name: build_fmu(name, cache_dir, force) for name in FMU_WRAPPERS}
-
-
 def package_name(digest: str) -> str:
     """The package an FMU's Python code is packed as: unique to the build."""
     return f"mechcosim_{digest}"
 
 
-def _build(wrapper: FmuWrapper, digest: str, tmp: Path) -> Path:
+def _build(record: FmuRecord, digest: str, needs: list[str], tmp: Path) -> Path:
     package = package_name(digest)
-    modules = component_modules(wrapper)
-    needs = requirements(modules)
+    modules = record.modules()
     stage = tmp / "stage"
     code = stage / package
     (code / "components").mkdir(parents=True)
@@ -180,23 +138,20 @@ def _build(wrapper: FmuWrapper, digest: str, tmp: Path) -> Path:
     shutil.copy2(SLAVE_MODULE, code)
     for module in modules:
         shutil.copy2(module, code / "components")
-    script = stage / f"{wrapper.script.stem}_{digest}.py"
+    script = stage / f"{record.script.stem}_{digest}.py"
     script.write_text(
         re.sub(
             r"^from component_slave import",
             f"from {package}.component_slave import",
-            wrapper.script.read_text(),
+            record.script.read_text(),
             flags=re.M,
         )
     )
     (stage / "requirements.txt").write_text("".join(f"{line}\n" for line in needs))
     docs = tmp / "documentation"
     docs.mkdir()
-    component_class = wrapper.component_class()
-    loader = loader_binary(wrapper.name)
-    (docs / "index.html").write_text(
-        render_documentation(wrapper, component_class, needs, loader=loader is not None)
-    )
+    loader = loader_binary(record.name)
+    (docs / "index.html").write_text(render_documentation(record, loader=loader is not None))
     modules_before = set(sys.modules)
     try:
         built = FmuBuilder.build_FMU(
@@ -213,7 +168,7 @@ def _build(wrapper: FmuWrapper, digest: str, tmp: Path) -> Path:
                 del sys.modules[module]
         while str(stage) in sys.path:
             sys.path.remove(str(stage))
-    _finish(Path(built), component_class, wrapper.name, digest, loader)
+    _finish(Path(built), record.component_class, record.name, digest, loader)
     return Path(built)
 
 

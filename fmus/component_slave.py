@@ -57,16 +57,17 @@ _CAUSALITY = {
 
 
 class ComponentSlave(Fmi2Slave):
-    """Generic slave: subclasses set ``component`` and the metadata below."""
+    """Generic slave: subclasses state ``component`` and the metadata below, as literals
+    (``fmus.registry`` reads them from the script; it requires all but ``examples``)."""
 
     #: "module.Class" of the component, the module inside the ``components`` package
     component: ClassVar[str]
     #: scenes (paths from the project root) that couple it with other FMUs; read, not run,
     #: by ``fmus.registry`` for the FMU's documentation
     examples: ClassVar[tuple[str, ...]] = ()
-    description: ClassVar[str] = ""
+    description: ClassVar[str]
     #: (start, stop, step) of the experiment `fmpy simulate` runs when given the FMU alone
-    default_run: ClassVar[tuple[float, float, float]] = (0.0, 1.0, 1.0e-3)
+    default_run: ClassVar[tuple[float, float, float]]
 
     author = "mechcosim"
     license = "MIT"

@@ -2,73 +2,53 @@
 
 ``render_documentation`` writes one self-contained HTML5 page (inline CSS, no scripts, no
 external resources) from what the project already states once: the component's docstrings
-(which cite the source documents), its VARIABLES and PORTS tables, its regime names, the
-wrapper script's description, and the example scenes of the registry entry, read from the
-project's ``scenarios/`` at build time.  The page tells a user of another tool (FMPy,
-libcosim, a C/C++ master) what the FMU models, how to couple it, and what its host needs.
+(which cite the source documents), its VARIABLES and PORTS tables, its regime names, and
+the FMU's record (``fmus.registry``): the wrapper script's description and default
+experiment, the requirements, and how the example scenes couple the FMU (their structure,
+not their values).  The page tells a user of another tool (FMPy, libcosim, a C/C++ master)
+what the FMU models, how to couple it, and what its host needs.
 """
 
 from __future__ import annotations
 
-import ast
-import importlib
 import inspect
 import re
 import shlex
 import sys
 import textwrap
-import tomllib
-from dataclasses import dataclass
 from html import escape
 from pathlib import Path
-from typing import Any
 
 from components.base import COMMON_OUTPUTS, Component
 from fmus.description import EVENT_TIME, INDICATOR_PREFIX, REGIME
-from fmus.registry import FMU_WRAPPERS, FmuWrapper
+from fmus.example_scenes import ExampleScene
+from fmus.ports import PORT_RULE
+from fmus.registry import FmuRecord
 
-PROJECT_DIR = Path(__file__).resolve().parent.parent
 #: Outputs every component shares (energy bookkeeping): poor examples of what one computes.
 _COMMON = {v.name for v in COMMON_OUTPUTS} | {"external_work"}
-#: What the slave class uses when a wrapper script sets no ``default_run``.
-_DEFAULT_RUN = (0.0, 1.0, 1.0e-3)
 SAMPLED_NOTE = (
     "sampled: the value is taken as a state at the start of each step, not a signal held "
     "over the step; a master should not average it"
 )
-PORT_RULE = (
-    "Connecting two ports joins each role present on both sides, from the side where it is "
-    "an output to the side where it is an input. A role present on one side only is not "
-    "connected."
-)
-
-
-class DocumentationError(RuntimeError):
-    """The documentation cannot be written (a missing example scene, a broken connection)."""
 
 
 # -- public entry point ---------------------------------------------------------------------
-def render_documentation(
-    wrapper: FmuWrapper,
-    component_class: type[Component],
-    requirements: list[str],
-    loader: bool = True,
-) -> str:
+def render_documentation(record: FmuRecord, loader: bool = True) -> str:
     """The FMU's ``documentation/index.html``: a complete, standalone HTML5 page.
     ``loader``: the FMU's Linux binary is the loader (``fmus.host_loader``) that lets hosts
     without Python run it, not pythonfmu's runtime alone."""
-    slave = _slave_metadata(wrapper.script)
-    description = (slave.description or _first_line(component_class.__doc__)).rstrip(".")
-    examples = [_read_example(wrapper, path) for path in wrapper.examples]
-    title = f"{wrapper.name}: FMU documentation"
+    component_class = record.component_class
+    description = record.description.rstrip(".")
+    title = f"{record.name}: FMU documentation"
     sections = [
-        ("model", "What it models", _model_section(wrapper, component_class, description)),
+        ("model", "What it models", _model_section(record, description)),
         ("ports", "Ports", _ports_section(component_class)),
         ("variables", "Variables", _variables_section(component_class)),
-        ("regimes", "Regimes and events", _regimes_section(wrapper, component_class)),
-        ("coupling", "How to couple it", _coupling_section(wrapper, examples)),
-        ("host", "Host requirements", _host_section(wrapper, requirements, loader)),
-        ("tools", "Usage in other tools", _tools_section(wrapper, component_class, slave)),
+        ("regimes", "Regimes and events", _regimes_section(record)),
+        ("coupling", "How to couple it", _coupling_section(record, record.examples())),
+        ("host", "Host requirements", _host_section(record, loader)),
+        ("tools", "Usage in other tools", _tools_section(record)),
         ("capabilities", "FMI capabilities", _capabilities_section()),
     ]
     toc = "".join(f'<li><a href="#{key}">{escape(head)}</a></li>' for key, head, _ in sections)
@@ -81,74 +61,20 @@ def render_documentation(
         '<html lang="en">\n<head>\n<meta charset="utf-8">\n'
         '<meta name="viewport" content="width=device-width, initial-scale=1">\n'
         f"<title>{escape(title)}</title>\n<style>{_CSS}</style>\n</head>\n<body>\n"
-        f"<header>\n<h1>{escape(wrapper.name)}</h1>\n"
+        f"<header>\n<h1>{escape(record.name)}</h1>\n"
         f'<p class="lead">{escape(description)}</p>\n'
         "<dl>"
-        f"<dt>Model identifier</dt><dd><code>{escape(wrapper.name)}</code></dd>"
+        f"<dt>Model identifier</dt><dd><code>{escape(record.name)}</code></dd>"
         "<dt>Standard</dt><dd>FMI 2.0, co-simulation</dd>"
-        f"<dt>Component</dt><dd><code>{escape(wrapper.component)}</code> "
+        f"<dt>Component</dt><dd><code>{escape(record.component)}</code> "
         "(plain Python, wrapped by a generic pythonfmu slave)</dd>"
         "</dl>\n</header>\n"
         f'<nav>\n<h2>Contents</h2>\n<ol class="toc">{toc}</ol>\n</nav>\n'
         f"<main>\n{body}</main>\n"
         "<footer><p>Generated at build time from the component's declarations, docstrings "
-        "and example scenes.</p></footer>\n"
+        "and the example scenes' connections.</p></footer>\n"
         "</body>\n</html>\n"
     )
-
-
-# -- the wrapper script, read without importing it ------------------------------------------
-@dataclass(frozen=True)
-class _SlaveMetadata:
-    description: str
-    default_run: tuple[float, float, float]
-
-
-def _slave_metadata(script: Path) -> _SlaveMetadata:
-    """``description`` and ``default_run`` of the script's slave class.
-
-    Parsed, not imported: the script imports ``component_slave``, which exists as a
-    top-level module only inside a built FMU.
-    """
-    tree = ast.parse(script.read_text(), filename=str(script))
-    for node in tree.body:
-        if not isinstance(node, ast.ClassDef):
-            continue
-        if not any(_base_name(b) == "ComponentSlave" for b in node.bases):
-            continue
-        found: dict[str, Any] = {}
-        for stmt in node.body:
-            if isinstance(stmt, ast.Assign):
-                targets, value = stmt.targets, stmt.value
-            elif isinstance(stmt, ast.AnnAssign) and stmt.value is not None:
-                targets, value = [stmt.target], stmt.value
-            else:
-                continue
-            for target in targets:
-                if isinstance(target, ast.Name) and target.id in ("description", "default_run"):
-                    try:
-                        found[target.id] = ast.literal_eval(value)
-                    except ValueError:
-                        raise DocumentationError(
-                            f"{script}: {target.id} of {node.name} is not a literal"
-                        ) from None
-        run = tuple(float(x) for x in found.get("default_run", _DEFAULT_RUN))
-        if len(run) != 3:
-            raise DocumentationError(f"{script}: default_run must be (start, stop, step)")
-        return _SlaveMetadata(str(found.get("description", "")), (run[0], run[1], run[2]))
-    raise DocumentationError(f"{script}: no subclass of ComponentSlave")
-
-
-def _base_name(node: ast.expr) -> str:
-    if isinstance(node, ast.Name):
-        return node.id
-    if isinstance(node, ast.Attribute):
-        return node.attr
-    return ""
-
-
-def _first_line(doc: str | None) -> str:
-    return inspect.cleandoc(doc or "").split("\n", 1)[0]
 
 
 # -- docstrings as HTML -----------------------------------------------------------------------
@@ -230,10 +156,11 @@ def _block_html(lines: list[str]) -> list[str]:
 
 
 # -- sections -----------------------------------------------------------------------------------
-def _model_section(wrapper: FmuWrapper, cls: type[Component], description: str) -> str:
+def _model_section(record: FmuRecord, description: str) -> str:
+    cls = record.component_class
     module = sys.modules[cls.__module__]
     return (
-        f"<p><strong>{escape(wrapper.name)}</strong>: {escape(description)}.</p>\n"
+        f"<p><strong>{escape(record.name)}</strong>: {escape(description)}.</p>\n"
         "<p>The sources (reports, equations, tables, pages) are cited in the component's own "
         "documentation, reproduced here.</p>\n"
         f"<h3>Module <code>{escape(cls.__module__)}</code></h3>\n"
@@ -316,7 +243,8 @@ def _variables_section(cls: type[Component]) -> str:
     )
 
 
-def _regimes_section(wrapper: FmuWrapper, cls: type[Component]) -> str:
+def _regimes_section(record: FmuRecord) -> str:
+    cls = record.component_class
     names: dict[int, str] = getattr(cls, "REGIME_NAMES", {})
     outputs = cls.variables("output")
     parts = []
@@ -328,7 +256,7 @@ def _regimes_section(wrapper: FmuWrapper, cls: type[Component]) -> str:
         parts.append(
             f"<p>The output <code>{REGIME}</code> gives the regime (mode) the component is "
             "in. In the model description it is an Enumeration (type "
-            f"<code>{escape(wrapper.name)}.Regime</code>) whose items are these names; read "
+            f"<code>{escape(record.name)}.Regime</code>) whose items are these names; read "
             "it as an Integer (fmi2GetInteger).</p>\n"
             '<table id="regimes">\n<thead><tr><th>code</th><th>regime</th></tr></thead>\n'
             f"<tbody>{rows}</tbody>\n</table>\n"
@@ -364,7 +292,7 @@ def _regimes_section(wrapper: FmuWrapper, cls: type[Component]) -> str:
     return "".join(parts)
 
 
-def _coupling_section(wrapper: FmuWrapper, examples: list[_Example]) -> str:
+def _coupling_section(record: FmuRecord, examples: list[ExampleScene]) -> str:
     rule = (
         '<p>Ports connect by the rule of <a href="#ports">Ports</a>; a single signal '
         "connects one output to one input of the same type and unit (each input driven by "
@@ -380,14 +308,15 @@ def _coupling_section(wrapper: FmuWrapper, examples: list[_Example]) -> str:
     intro = (
         "<p>The scenes below, from the project's <code>scenarios/</code>, are worked "
         "couplings of this FMU, every connection spelled out variable by variable as "
-        "another tool needs it. Parameter values are as the scene writes them: a value "
-        "with a unit must be converted to the SI unit shown before it is set on the FMU; a "
-        "bare number is already SI.</p>\n"
+        "another tool needs it. The values each scene sets are in its file: a value with a "
+        "unit is converted to the SI unit of the variables table before it is set on the "
+        "FMU; a bare number is already SI.</p>\n"
     )
-    return rule + intro + "".join(_example_html(wrapper, ex) for ex in examples)
+    return rule + intro + "".join(_example_html(record, ex) for ex in examples)
 
 
-def _host_section(wrapper: FmuWrapper, requirements: list[str], loader: bool) -> str:
+def _host_section(record: FmuRecord, loader: bool) -> str:
+    requirements = record.requirements()
     if requirements:
         reqs = "".join(f"<li><code>{escape(r)}</code></li>" for r in requirements)
         reqs = f"<ul>{reqs}</ul>\n"
@@ -396,7 +325,7 @@ def _host_section(wrapper: FmuWrapper, requirements: list[str], loader: bool) ->
     else:
         reqs = "<p>No packages beyond the standard library.</p>\n"
         install_cmd = ""
-    fmu = f"{wrapper.name}.fmu"
+    fmu = f"{record.name}.fmu"
     version = f"{sys.version_info.major}.{sys.version_info.minor}"
     if loader:
         other_hosts = (
@@ -451,9 +380,10 @@ def _host_section(wrapper: FmuWrapper, requirements: list[str], loader: bool) ->
     )
 
 
-def _tools_section(wrapper: FmuWrapper, cls: type[Component], slave: _SlaveMetadata) -> str:
-    fmu = f"{wrapper.name}.fmu"
-    start, stop, step = slave.default_run
+def _tools_section(record: FmuRecord) -> str:
+    cls = record.component_class
+    fmu = f"{record.name}.fmu"
+    start, stop, step = record.default_run
     params = cls.variables("parameter")[:2]
     # The first output of the component's own (the energy outputs every component shares
     # say little about it), and the regime.
@@ -464,7 +394,7 @@ def _tools_section(wrapper: FmuWrapper, cls: type[Component], slave: _SlaveMetad
     simulate = (
         f"fmpy simulate {fmu}{sv_opt} --start-time {_g(start)} --stop-time {_g(stop)} "
         f"--step-size {_g(step)} --output-variables {' '.join(outputs)} "
-        f"--output-file {wrapper.name}.csv"
+        f"--output-file {record.name}.csv"
     )
     py_values = ", ".join(f'"{v.name}": {_number(v.start, v.type)}' for v in params)
     out_list = ", ".join(f'"{o}"' for o in outputs)
@@ -482,7 +412,7 @@ def _tools_section(wrapper: FmuWrapper, cls: type[Component], slave: _SlaveMetad
     cosim_values = " ".join(f"{v.name}={_number(v.start, v.type)}" for v in params)
     cosim = (
         f"cosim run-single {fmu} {cosim_values} "
-        f"-b {_g(start)} -d {_g(stop - start)} -s {_g(step)} --output-file {wrapper.name}.csv"
+        f"-b {_g(start)} -d {_g(stop - start)} -s {_g(step)} --output-file {record.name}.csv"
     )
     libcosim = "\n".join(
         [
@@ -491,7 +421,7 @@ def _tools_section(wrapper: FmuWrapper, cls: type[Component], slave: _SlaveMetad
             "",
             f"execution = CosimExecution.from_step_size(step_size={round(step * 1e9)})  # ns",
             f'index = execution.add_local_slave(CosimLocalSlave(fmu_path="{fmu}", '
-            f'instance_name="{wrapper.name.lower()}"))',
+            f'instance_name="{record.name.lower()}"))',
             "vr = {v.name.decode(): v.reference for v in execution.slave_variables(index)}",
             "# per connection: connect_real_variables(out_index, out_vr, in_index, in_vr),",
             "# connect_integer_variables(...) for an Integer connection",
@@ -545,112 +475,17 @@ def _capabilities_section() -> str:
 
 
 # -- example scenes ---------------------------------------------------------------------------
-@dataclass(frozen=True)
-class _Connection:
-    source: tuple[str, str]  # (instance, variable), an output
-    target: tuple[str, str]  # (instance, variable), an input
-    type: str  # "Real" or "Integer"
-    via: str  # the scene entry it comes from
-
-
-@dataclass(frozen=True)
-class _Example:
-    path: str
-    scene: dict[str, Any]
-    instances: dict[str, str]  # instance -> FMU model identifier
-    classes: dict[str, type[Component]]
-    connections: list[_Connection]
-
-
-def _read_example(wrapper: FmuWrapper, path: str) -> _Example:
-    file = PROJECT_DIR / path
-    if not file.is_file():
-        raise DocumentationError(
-            f"{wrapper.name}: example scene {path} (fmus/registry.py) does not exist "
-            f"in {PROJECT_DIR}"
-        )
-    try:
-        scene = tomllib.loads(file.read_text())
-    except tomllib.TOMLDecodeError as exc:
-        raise DocumentationError(f"{path}: not valid TOML: {exc}") from None
-    instances: dict[str, str] = {}
-    classes: dict[str, type[Component]] = {}
-    for instance, spec in scene.get("fmus", {}).items():
-        model = spec.get("component") if isinstance(spec, dict) else None
-        if model not in FMU_WRAPPERS:
-            raise DocumentationError(f"{path}: fmus.{instance}: unknown component {model!r}")
-        instances[instance] = model
-        classes[instance] = _component_class(FMU_WRAPPERS[model])
-    if wrapper.name not in instances.values():
-        raise DocumentationError(
-            f"{path}: no instance of {wrapper.name}, yet listed as its example"
-        )
-    connections = [
-        c
-        for i, entry in enumerate(scene.get("connections", []))
-        for c in _expand(path, i, entry, classes)
-    ]
-    return _Example(path, scene, instances, classes, connections)
-
-
-def _component_class(wrapper: FmuWrapper) -> type[Component]:
-    module, name = wrapper.component.rsplit(".", 1)
-    return getattr(importlib.import_module(module), name)
-
-
-def _expand(
-    path: str, i: int, entry: dict[str, Any], classes: dict[str, type[Component]]
-) -> list[_Connection]:
-    """One ``[[connections]]`` entry as variable-level connections (the port rule)."""
-    key = f"{path}: connections[{i}]"
-    if "ports" in entry:
-        (ia, pa), (ib, pb) = (_split(key, p, classes) for p in entry["ports"])
-        ca, cb = classes[ia], classes[ib]
-        if pa not in ca.PORTS or pb not in cb.PORTS:
-            raise DocumentationError(f"{key}: unknown port in {entry['ports']}")
-        roles_a, roles_b = ca.PORTS[pa], cb.PORTS[pb]
-        via = f"{ia}.{pa} \u2194 {ib}.{pb}"
-        out = []
-        for role in (r for r in roles_a if r in roles_b):
-            va, vb = ca.variable(roles_a[role]), cb.variable(roles_b[role])
-            if va.causality == "output" and vb.causality == "input":
-                out.append(_Connection((ia, va.name), (ib, vb.name), va.type, f"{via}: {role}"))
-            elif vb.causality == "output" and va.causality == "input":
-                out.append(_Connection((ib, vb.name), (ia, va.name), vb.type, f"{via}: {role}"))
-            else:
-                raise DocumentationError(f"{key}: role {role!r} is not output on one side only")
-        return out
-    if "from" not in entry or "to" not in entry:
-        raise DocumentationError(f"{key}: expected 'ports' or 'from' and 'to'")
-    src = _split(key, entry["from"], classes)
-    dst = _split(key, entry["to"], classes)
-    var = classes[src[0]].variable(src[1])
-    return [_Connection(src, dst, var.type, "signal")]
-
-
-def _split(key: str, ref: str, classes: dict[str, type[Component]]) -> tuple[str, str]:
-    instance, _, name = ref.partition(".")
-    if instance not in classes or not name:
-        raise DocumentationError(f"{key}: {ref!r} is not '<instance>.<name>' of a known instance")
-    return instance, name
-
-
-def _example_html(wrapper: FmuWrapper, ex: _Example) -> str:
-    scene = ex.scene.get("scene", {})
-    master = ex.scene.get("master", {})
+def _example_html(record: FmuRecord, ex: ExampleScene) -> str:
     stem = Path(ex.path).stem
-    head = f"<h3>Scene <code>{escape(ex.path)}</code></h3>\n"
-    if scene.get("description"):
-        head += f"<p>{escape(str(scene['description']))}.</p>\n"
-    settings = [f"{k} = {_toml(master[k])}" for k in ("algorithm", "step") if k in master]
-    settings += [f"stop = {_toml(scene['stop'])}"] if "stop" in scene else []
-    if settings:
-        head += f"<p>Master in the scene: <code>{escape(', '.join(settings))}</code>.</p>\n"
+    head = (
+        f"<h3>Scene <code>{escape(ex.path)}</code></h3>\n"
+        "<p>Its parameter values and master settings are in the scene file.</p>\n"
+    )
     inst_rows = "".join(
         f"<tr><td><code>{escape(inst)}</code></td><td><code>{escape(model)}</code>"
-        + (" (this FMU)" if model == wrapper.name else "")
+        + (" (this FMU)" if model == record.name else "")
         + "</td></tr>"
-        for inst, model in ex.instances.items()
+        for inst, model in ex.instances
     )
     conn_rows = []
     for n, c in enumerate(ex.connections, start=1):
@@ -673,29 +508,6 @@ def _example_html(wrapper: FmuWrapper, ex: _Example) -> str:
         if n_int
         else ""
     )
-    value_rows = []
-    for inst, spec in ex.scene.get("fmus", {}).items():
-        cls = ex.classes[inst]
-        for kind in ("parameters", "inputs"):
-            for name, value in spec.get(kind, {}).items():
-                try:
-                    unit = cls.variable(name).unit
-                except KeyError:
-                    raise DocumentationError(
-                        f"{ex.path}: fmus.{inst}.{kind}: {cls.__name__} has no {name!r}"
-                    ) from None
-                value_rows.append(
-                    f"<tr><td><code>{escape(inst)}</code></td><td>{kind[:-1]}</td>"
-                    f"<td><code>{escape(name)}</code></td>"
-                    f"<td><code>{escape(_toml(value))}</code></td><td>{escape(unit)}</td></tr>"
-                )
-    values = (
-        '<table class="values">\n<thead><tr><th>instance</th><th>kind</th><th>variable</th>'
-        "<th>value as written</th><th>FMU unit (SI)</th></tr></thead>\n"
-        f"<tbody>{''.join(value_rows)}</tbody>\n</table>\n"
-        if value_rows
-        else "<p>The scene sets no parameter: every FMU runs with its start values.</p>\n"
-    )
     return (
         head + '<table class="instances">\n<thead><tr><th>instance</th><th>FMU model</th></tr>'
         f"</thead>\n<tbody>{inst_rows}</tbody>\n</table>\n"
@@ -704,8 +516,6 @@ def _example_html(wrapper: FmuWrapper, ex: _Example) -> str:
         "<thead><tr><th>#</th><th>connection</th><th>type</th><th>from scene entry</th></tr>"
         f"</thead>\n<tbody>\n{chr(10).join(conn_rows)}\n</tbody>\n</table>\n"
         f"{int_note}"
-        "<p>Values the scene sets (parameters, and start values of inputs):</p>\n"
-        f"{values}"
     )
 
 
@@ -720,19 +530,6 @@ def _number(value: float | None, vtype: str) -> str:
 
 def _g(value: float) -> str:
     return repr(float(value))
-
-
-def _toml(value: Any) -> str:
-    """A TOML value as the scene writes it."""
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, str):
-        return '"' + value.replace("\\", "\\\\").replace('"', '\\"') + '"'
-    if isinstance(value, dict):
-        return "{ " + ", ".join(f"{k} = {_toml(v)}" for k, v in value.items()) + " }"
-    if isinstance(value, list):
-        return "[" + ", ".join(_toml(v) for v in value) + "]"
-    return repr(value)
 
 
 _CSS = """

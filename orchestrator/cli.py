@@ -101,7 +101,7 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument(
         "--stop",
         help="simulated time to compare over, e.g. '2 ms' (default: the scene's stop, "
-        "at most 10000 macro steps)",
+        "at most 5000 macro steps)",
     )
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
     p.set_defaults(handler=_crosscheck)
@@ -268,11 +268,12 @@ def _run_guarded(args: argparse.Namespace) -> int:
         message += " (full message in summary.json)"
     print(f"scene {scene.name}: {result.status}" + (f" — {message}" if message else ""))
     for name, q in result.headline.items():
-        value = q["value"] if isinstance(q["value"], str) else f"{q['value']:.10g}"
-        print(f"  {name:32s} {value} {q['unit']}")
+        print(headline_line(name, q))
     for name, value in result.accuracy.items():
         print(f"  {name:32s} {value:.4g}")
-    for warning in result.stats.extra.get("warnings", []):
+    for note in result.notes:  # what the analyses could not compute
+        print(f"  note: {note}")
+    for warning in result.stats.extra.get("warnings", []):  # what the master gave up
         print(f"  warning: {warning}")
     if result.status == "interrupted" and result.interrupted_by is not None:
         print(f"  interrupted at t = {result.time_reached:.9g} s (simulated)")
@@ -283,6 +284,15 @@ def _run_guarded(args: argparse.Namespace) -> int:
     )
     print(f"  results in {result.output_dir}")
     return 0 if result.status == "completed" else 1
+
+
+def headline_line(name: str, quantity: dict) -> str:
+    """One headline quantity as the run prints it; a dimensionless one (a count, a ratio)
+    without a unit."""
+    value = quantity["value"]
+    text = value if isinstance(value, str) else f"{value:.10g}"
+    unit = "" if quantity["unit"] in ("1", "") else f" {quantity['unit']}"
+    return f"  {name:32s} {text}{unit}"
 
 
 def _load(path: Path, overrides: dict, force: bool):  # noqa: ANN202 - a Scene
@@ -309,21 +319,21 @@ def _check(args: argparse.Namespace) -> int:
 
 def _build(args: argparse.Namespace) -> int:
     from fmus.build import build_fmu
-    from fmus.registry import FMU_WRAPPERS
+    from fmus.registry import FMU_RECORDS
     from orchestrator.cache import check_cache_dir
 
     check_cache_dir(args.dest)
-    for name in args.names or sorted(FMU_WRAPPERS):
+    for name in args.names or sorted(FMU_RECORDS):
         print(build_fmu(name, args.dest, force=args.force))
     return 0
 
 
 def _validate(args: argparse.Namespace) -> int:
-    from fmus.registry import FMU_WRAPPERS
+    from fmus.registry import FMU_RECORDS
     from orchestrator.fmu_checks import check_fmu
 
     failures = 0
-    for name in args.names or sorted(FMU_WRAPPERS):
+    for name in args.names or sorted(FMU_RECORDS):
         problems = check_fmu(name)
         print(f"{name}: {'ok' if not problems else 'FAILED'}")
         for problem in problems:
@@ -492,9 +502,3 @@ def _report(args: argparse.Namespace) -> int:
     keys = ("scene", "status", "message", "time_reached", "crash", "headline", "notes", "stats")
     print(json.dumps({k: summary[k] for k in keys if k in summary}, indent=2))
     return 0
-
-
-if __name__ == "__main__":
-    from orchestrator.entry import main as entry
-
-    sys.exit(entry())

@@ -8,7 +8,7 @@ from fmpy import read_model_description, simulate_fmu
 from fmpy.validation import validate_fmu
 
 from fmus.build import build_fmu
-from fmus.registry import FMU_WRAPPERS
+from fmus.registry import FMU_RECORDS
 from orchestrator.fmu_instance import FmuInstance
 
 
@@ -38,7 +38,7 @@ def check_fmu(name: str, cache_dir: Path | None = None) -> list[str]:
 
 
 def _dimensionless(fmu_name: str, var: str) -> bool:
-    return FMU_WRAPPERS[fmu_name].component_class().variable(var).unit == "1"
+    return FMU_RECORDS[fmu_name].component_class.variable(var).unit == "1"
 
 
 def state_round_trip_problems(path: Path, steps: int = 20, h: float = 1e-4) -> list[str]:

@@ -41,7 +41,7 @@ from orchestrator.summary_file import not_started_summary, write_summary
 from orchestrator.system import CoupledSystem
 
 
-@dataclass
+@dataclass(kw_only=True)
 class RunResult:
     scene: Scene
     status: str  # "completed", "failed" or "interrupted"
@@ -171,8 +171,6 @@ def _run_locked(
     if guard.signum is not None and status == "completed":
         status = "interrupted"
         message = f"interrupted by {signal_name(guard.signum)} after the run ended"
-    if notes:
-        stats.extra.setdefault("warnings", []).extend(notes)
     recorder.close(
         {
             "scene": scene.name,
@@ -187,21 +185,21 @@ def _run_locked(
         }
     )
     return RunResult(
-        scene,
-        status,
-        message,
-        recorder.header,
-        data,
-        recorder.events,
-        stats,
-        quantities,
-        out,
-        accuracy,
-        meta,
-        reached[0],
-        notes,
-        guard.signum if status == "interrupted" else None,
-        ref,
+        scene=scene,
+        status=status,
+        message=message,
+        header=recorder.header,
+        data=data,
+        events=recorder.events,
+        stats=stats,
+        headline=quantities,
+        output_dir=out,
+        accuracy=accuracy,
+        metadata=meta,
+        time_reached=reached[0],
+        notes=notes,
+        interrupted_by=guard.signum if status == "interrupted" else None,
+        reference=ref,
     )
 
 

@@ -15,7 +15,8 @@ from typing import Any
 
 from components.base import Component
 from fmus.build import BuildError, build_fmu
-from fmus.registry import FMU_WRAPPERS
+from fmus.ports import PortError, PortSide, join_ports
+from fmus.registry import FMU_RECORDS
 from orchestrator.errors import ScenarioError
 from orchestrator.master_settings import (
     ALGORITHMS,
@@ -27,8 +28,8 @@ from orchestrator.master_settings import (
     read_options,
 )
 from orchestrator.model_info import ModelInfo, ModelInfoError, VariableInfo, model_info
-from orchestrator.scenes import ANALYSES, REFERENCES, family
-from orchestrator.scenes.family import Option
+from orchestrator.scenes import ANALYSES, REFERENCES, family, shared_parameters
+from orchestrator.scenes.family import Option, SharedParameter
 from orchestrator.signals import (
     Reader,
     Signal,
@@ -47,13 +48,6 @@ REDUCTIONS = ("final", "initial", "max", "min", "maxabs", "mean")
 
 #: More macro steps than this cannot finish in any sensible time: refused unless forced.
 MAX_STEPS = 1e8
-
-#: Parameters that mean one physical quantity wherever they appear: when a scene holds
-#: several of these components, their values of the parameter must agree.  Keyed by our
-#: components' names (fmus.registry), so it holds for every scene of the family.
-SHARED_PARAMETERS: tuple[tuple[str, frozenset[str], str], ...] = (
-    ("spin", frozenset({"GearTrain", "ClockGearTrain", "VergeEscapement"}), "the fuze spin rate"),
-)
 
 
 @dataclass(frozen=True)
@@ -146,11 +140,7 @@ class Scene:
         component = self.fmus[instance].component
         if component is None:
             raise ValueError(f"FMU instance {instance!r} is not one of this project's components")
-        return component_class(component)
-
-
-def component_class(fmu_name: str) -> type[Component]:
-    return FMU_WRAPPERS[fmu_name].component_class()
+        return FMU_RECORDS[component].component_class
 
 
 def load_scene(
@@ -292,7 +282,17 @@ class _Loader:
         self.check_keys(
             raw,
             "",
-            {"scene", "fmus", "connections", "master", "output", "report", "sweep", "study"},
+            {
+                "scene",
+                "parameters",
+                "fmus",
+                "connections",
+                "master",
+                "output",
+                "report",
+                "sweep",
+                "study",
+            },
         )
         for section in ("scene", "fmus", "master"):
             if section not in raw:
@@ -310,8 +310,8 @@ class _Loader:
         if not stop > start:
             raise self.fail("scene.stop", f"must be later than scene.start ({start} s), got {stop}")
         self.span = (start, stop)  # a signal refuses a run past its span
-        fmus = self.fmus(self.table(raw["fmus"], "fmus"))
-        self.shared_parameters(fmus)
+        shared = self.table(raw.get("parameters", {}), "parameters")
+        fmus = self.fmus(self.table(raw["fmus"], "fmus"), shared)
         stop_when = self.stop_when(head["stop_when"], fmus) if "stop_when" in head else None
         connections = self.connections(raw.get("connections", []), fmus)
         self.signals_not_connected(connections, fmus)
@@ -346,30 +346,6 @@ class _Loader:
             study=study,
         )
 
-    def shared_parameters(self, fmus: dict[str, FmuSpec]) -> None:
-        """Parameters that are one quantity across components (SHARED_PARAMETERS) agree."""
-        for name, components, meaning in SHARED_PARAMETERS:
-            values = []
-            for instance, spec in fmus.items():
-                if spec.component not in components:
-                    continue
-                var = spec.model.variables.get(name)
-                if var is None or var.causality != "parameter":
-                    continue
-                try:
-                    value = float(spec.parameters.get(name, var.start))
-                except (TypeError, ValueError):
-                    continue
-                values.append((instance, value, var.unit or ""))
-            for instance, value, unit in values[1:]:
-                first, v0, _ = values[0]
-                if not math.isclose(value, v0, rel_tol=1e-9, abs_tol=1e-12):
-                    raise self.fail(
-                        f"fmus.{instance}.parameters.{name}",
-                        f"{value:.9g} {unit} differs from {first}'s {v0:.9g} {unit}: "
-                        f"{name} is {meaning}, one value for every FMU of the scene",
-                    )
-
     def stop_when(self, node: Any, fmus: dict[str, FmuSpec]) -> StopCondition:
         key = "scene.stop_when"
         node = self.table(node, key)
@@ -386,7 +362,8 @@ class _Loader:
         threshold = self.quantity(node[side], f"{key}.{side}", var.unit or "1")
         return StopCondition(signal, threshold, rising=side == "above")
 
-    def fmus(self, node: dict[str, Any]) -> dict[str, FmuSpec]:
+    def fmus(self, node: dict[str, Any], shared: dict[str, Any]) -> dict[str, FmuSpec]:
+        """The [fmus.<instance>] tables, each given the [parameters] its component shares."""
         if not node:
             raise self.fail("fmus", "no FMU given; expected at least one [fmus.<instance>] table")
         specs = {}
@@ -402,6 +379,9 @@ class _Loader:
             except ModelInfoError as exc:
                 raise self.fail(f"{key}.fmu", str(exc)) from None
             params = self.values(entry.get("parameters", {}), f"{key}.parameters", model)
+            for name, value in shared.items():
+                if _takes(component, model, shared_parameters().get(name)):
+                    params[name] = self.value(value, f"parameters.{name}", model.variables[name])
             inputs = self.values(entry.get("inputs", {}), f"{key}.inputs", model)
             signals = {n: inputs.pop(n) for n, v in list(inputs.items()) if isinstance(v, Signal)}
             # Initialization sees each signal's value at the start (before a jump there).
@@ -410,14 +390,62 @@ class _Loader:
             specs[instance] = FmuSpec(
                 instance, name, path, model, params, inputs, component, signals
             )
+        self.check_shared(node, shared, specs)
         return specs
+
+    def check_shared(
+        self, node: dict[str, Any], shared: dict[str, Any], fmus: dict[str, FmuSpec]
+    ) -> None:
+        """A shared parameter is stated once, in [parameters], and some FMU takes it."""
+        taken = {
+            p.name: p
+            for p in shared_parameters().values()
+            for spec in fmus.values()
+            if _takes(spec.component, spec.model, p)
+        }
+        for instance, entry in node.items():
+            for name in entry.get("parameters", {}):
+                if name in taken and _takes(
+                    fmus[instance].component, fmus[instance].model, taken[name]
+                ):
+                    raise self.fail(
+                        f"fmus.{instance}.parameters.{name}",
+                        f"{name} is {taken[name].meaning}, shared by "
+                        f"{', '.join(sorted(taken[name].components))}: state it once for the "
+                        f"scene as parameters.{name} (a [parameters] table)",
+                    )
+        for name in shared:
+            if name not in taken:
+                raise self.fail(
+                    f"parameters.{name}",
+                    "not a parameter the scene's FMUs share (set it in [fmus.<instance>] "
+                    f"parameters); expected one of {sorted(taken)}"
+                    if taken
+                    else "no FMU of the scene shares a parameter: set it in "
+                    "[fmus.<instance>] parameters",
+                )
+
+    def key_variables(self, dotted: str, fmus: dict[str, FmuSpec]) -> list[tuple[str, str, str]]:
+        """The FMU variables a dotted key sets, as (instance, "parameters" or "inputs",
+        variable); [] for a key that sets none (master.*, scene.*)."""
+        parts = _split_key(dotted)
+        if len(parts) == 4 and parts[0] == "fmus" and parts[2] in ("parameters", "inputs"):
+            return [(parts[1], parts[2], parts[3])]
+        if len(parts) == 2 and parts[0] == "parameters":
+            shared = shared_parameters().get(parts[1])
+            return [
+                (instance, "parameters", parts[1])
+                for instance, spec in fmus.items()
+                if _takes(spec.component, spec.model, shared)
+            ]
+        return []
 
     def fmu_file(self, entry: dict[str, Any], key: str) -> tuple[str | None, Path]:
         """(registry name or None, FMU file) of one [fmus.<instance>] table."""
         if ("component" in entry) == ("fmu" in entry):
             raise self.fail(
                 key,
-                f"expected exactly one of 'component' (one of {sorted(FMU_WRAPPERS)}) or "
+                f"expected exactly one of 'component' (one of {sorted(FMU_RECORDS)}) or "
                 "'fmu' (the path of an FMI 2.0 co-simulation FMU, relative to the scene file)",
             )
         if "fmu" in entry:
@@ -427,10 +455,10 @@ class _Loader:
                 raise self.fail(f"{key}.fmu", f"no FMU file at {path}")
             return None, path
         component = self.string(entry, "component", f"{key}.component")
-        if component not in FMU_WRAPPERS:
+        if component not in FMU_RECORDS:
             raise self.fail(
                 f"{key}.component",
-                f"unknown {component!r}; expected one of {sorted(FMU_WRAPPERS)}",
+                f"unknown {component!r}; expected one of {sorted(FMU_RECORDS)}",
             )
         try:
             return component, build_fmu(component, self.cache_dir)
@@ -554,23 +582,15 @@ class _Loader:
             if name not in model.ports:
                 known = sorted(model.ports) or "none: it declares no ports, connect variables"
                 raise self.fail(key, f"{instance!r} has no port {name!r}; expected one of {known}")
-            sides.append((instance, model, model.ports[name]))
-        (ia, ma, pa), (ib, mb, pb) = sides
-        roles = sorted(set(pa) & set(pb))
-        if not roles:
-            raise self.fail(key, f"ports {ports} share no role (angle, speed, torque, ...)")
-        out = []
-        for role in roles:
-            va, vb = ma.variables[pa[role]], mb.variables[pb[role]]
-            if va.causality == "output" and vb.causality == "input":
-                out.append(Connection((ia, va.name), (ib, vb.name)))
-            elif vb.causality == "output" and va.causality == "input":
-                out.append(Connection((ib, vb.name), (ia, va.name)))
-            else:
-                raise self.fail(
-                    key, f"role {role!r}: one side must output it and the other take it as input"
-                )
-        return out
+            variables = model.variables
+            sides.append(
+                PortSide(instance, name, model.ports[name], lambda v, vs=variables: vs[v].causality)
+            )
+        try:
+            links = join_ports(*sides)
+        except PortError as exc:
+            raise self.fail(key, str(exc)) from None
+        return [Connection(link.source, link.target) for link in links]
 
     def check_connection(self, c: Connection, fmus: dict[str, FmuSpec], key: str) -> None:
         """Types must match (Real to Real, Integer or Enumeration to either) and units agree
@@ -608,12 +628,6 @@ class _Loader:
             raise self.fail("master.step", f"must be positive, got {step} s")
         if step > duration:
             raise self.fail("master.step", f"{step} s is longer than the run ({duration} s)")
-        if duration / step > MAX_STEPS and algorithm != "regime-aware" and not self.force:
-            raise self.fail(
-                "master.step",
-                f"{step:g} s over {duration:g} s is {duration / step:.3g} macro steps, more "
-                f"than the limit {MAX_STEPS:.0e}: the run would not finish (--force to run it)",
-            )
         order = node.get("order", list(fmus))
         if not (
             isinstance(order, list)
@@ -626,7 +640,13 @@ class _Loader:
             settings = master_settings(algorithm, step, duration, options)
         except SettingError as exc:
             raise self.fail(f"master.{exc.key}", str(exc)) from None
-        largest = getattr(settings, "max_step", None)
+        largest = getattr(settings, "max_step", None)  # a master that varies its step
+        if largest is None and duration / step > MAX_STEPS and not self.force:
+            raise self.fail(
+                "master.step",
+                f"{step:g} s over {duration:g} s is {duration / step:.3g} macro steps, more "
+                f"than the limit {MAX_STEPS:.0e}: the run would not finish (--force to run it)",
+            )
         if largest is not None:
             if duration / largest > MAX_STEPS and not self.force:
                 raise self.fail(
@@ -828,6 +848,12 @@ class _Loader:
             if var is None or var.causality != causality:
                 raise self.fail(key, f"{fmus[instance].fmu} has no {causality} {name!r}")
             return var.unit or "1"
+        if len(parts) == 2 and parts[0] == "parameters":
+            targets = self.key_variables(dotted, fmus)
+            if not targets:
+                raise self.fail(key, f"no FMU of the scene shares a parameter {parts[1]!r}")
+            instance, _, name = targets[0]
+            return fmus[instance].model.variables[name].unit or "1"
         if len(parts) == 2 and parts[0] == "master" and parts[1] in SETTING_KINDS:
             if SETTING_KINDS[parts[1]].choices:
                 raise self.fail(key, f"cannot sweep {dotted!r}: it is a word, not a number")
@@ -839,10 +865,19 @@ class _Loader:
         raise self.fail(
             key,
             f"cannot sweep {dotted!r}; expected fmus.<instance>.parameters.<name>, "
-            "fmus.<instance>.inputs.<name>, master.<setting> or scene.start/stop",
+            "fmus.<instance>.inputs.<name>, parameters.<shared name>, master.<setting> or "
+            "scene.start/stop",
         )
 
     def number(self, value: Any, k: int) -> float:
         if isinstance(value, bool) or not isinstance(value, int | float):
             raise self.fail(f"sweep.values[{k}]", f"expected a number, got {value!r}")
         return float(value)
+
+
+def _takes(component: str | None, model: ModelInfo, shared: SharedParameter | None) -> bool:
+    """Whether one of our FMUs (``component``) takes a shared parameter."""
+    if shared is None or component not in shared.components:
+        return False
+    var = model.variables.get(shared.name)
+    return var is not None and var.causality == "parameter"

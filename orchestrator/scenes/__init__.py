@@ -15,7 +15,7 @@ from importlib import import_module
 from pathlib import Path
 
 from orchestrator.lazy import LazyRegistry
-from orchestrator.scenes.family import SceneFamily
+from orchestrator.scenes.family import SceneFamily, SharedParameter
 
 #: Family names, as ``[report] analysis`` / ``reference`` name them.
 FAMILY_NAMES: tuple[str, ...] = tuple(
@@ -27,6 +27,20 @@ FAMILY_NAMES: tuple[str, ...] = tuple(
 def family(name: str) -> SceneFamily:
     """The declaration of family ``name`` (imports only its package's ``__init__``)."""
     return import_module(f"{__name__}.{name}").FAMILY
+
+
+@cache
+def shared_parameters() -> dict[str, SharedParameter]:
+    """Every family's shared parameters, by name (the FMUs that take one joined)."""
+    found: dict[str, SharedParameter] = {}
+    for name in FAMILY_NAMES:
+        for p in family(name).shared:
+            known = found.get(p.name)
+            components = p.components | (known.components if known else frozenset())
+            found[p.name] = SharedParameter(
+                p.name, components, known.meaning if known else p.meaning
+            )
+    return found
 
 
 def _registry(role: str) -> LazyRegistry:

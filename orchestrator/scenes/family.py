@@ -91,6 +91,18 @@ class Needs:
 
 
 @dataclass(frozen=True)
+class SharedParameter:
+    """A parameter that is one physical quantity for several of a family's FMUs (the fuze
+    spin rate of a gear train and its escapement).  A scene states it once, in its
+    [parameters] table, and every instance of ``components`` gets that value; a value
+    given in one instance's own parameters is refused."""
+
+    name: str
+    components: frozenset[str]  # our FMUs (fmus.registry) that take it, each by this name
+    meaning: str
+
+
+@dataclass(frozen=True)
 class SceneFamily:
     """One family of scenes (``[report] analysis`` / ``reference`` name it): what it reads,
     and where its analysis, plot and reference live ("module:function", imported when used).
@@ -98,25 +110,11 @@ class SceneFamily:
     analysis: (scene, header, data, options) -> {name: Quantity}
     plot: (scene, header, data, path) -> None, writing a PNG at path
     reference: (scene) -> Reference, the monolithic yardstick of the coupling error
+    shared: the parameters its FMUs share (they hold in every scene with those FMUs)
     """
 
     needs: Needs = field(default_factory=Needs)
     analysis: str | None = None
     plot: str | None = None
     reference: str | None = None
-
-
-_ESCAPEMENT_FORCES = ("phi", "phi_dot", "regime", "F12", "F23", "FF12", "FF23")
-_VERGE = ("regime", "PN", "impact_count")
-
-
-def escapement_needs(train_component: str) -> Needs:
-    """What a spin-driven train + verge escapement family reads: the train's angle, speed,
-    regime and mesh forces, the verge's regime, normal force and impact count."""
-    return Needs(
-        options=(Option("train"), Option("verge")),
-        roles=(
-            Role(train_component, "train", "train", _ESCAPEMENT_FORCES),
-            Role("VergeEscapement", "verge", "verge", _VERGE),
-        ),
-    )
+    shared: tuple[SharedParameter, ...] = ()

@@ -22,18 +22,7 @@ from orchestrator.scenes.clock_train.monolithic import run_clock_train
 from orchestrator.scenes.m739.monolithic import run_m739
 from orchestrator.studies.jobs import JobResult, run_job, run_jobs
 from orchestrator.studies.parameter_sweep import sweep_jobs
-
-SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
-
-
-def _best_per_call(fn: Callable[[int], None], n: int, repeats: int = 5) -> float:
-    """Best-of-repeats seconds per call of a loop of n calls."""
-    best = float("inf")
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        fn(n)
-        best = min(best, (time.perf_counter() - t0) / n)
-    return best
+from orchestrator.studies.timing import SCENARIOS, best_per_call
 
 
 def overhead(n: int = 20000) -> dict[str, float]:
@@ -82,11 +71,11 @@ def overhead(n: int = 20000) -> dict[str, float]:
         run_scene(scene, output_dir=Path("runs") / "bench_overhead", show_progress=False)
 
     results = {
-        "component step (plain Python)": _best_per_call(plain, n),
-        "FMU doStep through fmpy": _best_per_call(through_fmu, n),
-        "FMU setReal + doStep + getReal": _best_per_call(exchange_and_step, n),
-        "coupled pair, plain Python, per macro step": _best_per_call(plain_pair, n),
-        "coupled pair, Jacobi master + FMUs + recording, per macro step": _best_per_call(
+        "component step (plain Python)": best_per_call(plain, n),
+        "FMU doStep through fmpy": best_per_call(through_fmu, n),
+        "FMU setReal + doStep + getReal": best_per_call(exchange_and_step, n),
+        "coupled pair, plain Python, per macro step": best_per_call(plain_pair, n),
+        "coupled pair, Jacobi master + FMUs + recording, per macro step": best_per_call(
             master, n, repeats=3
         ),
     }

@@ -14,7 +14,7 @@ import sys
 import threading
 from collections.abc import Callable, Iterator
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -46,6 +46,7 @@ class JobResult:
     header: list[str]
     data: np.ndarray
     events: list[tuple[float, str, str, str]]
+    notes: list[str] = field(default_factory=list)  # what the analyses could not compute
 
 
 def run_job(job: Job) -> JobResult:
@@ -67,6 +68,7 @@ def run_job(job: Job) -> JobResult:
         result.header,
         result.data,
         result.events,
+        result.notes,
     )
 
 

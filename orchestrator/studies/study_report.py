@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from orchestrator.studies import study_statistics as st
-from orchestrator.studies.tolerance_study import OK, StudyResult, study_unit_points
+from orchestrator.studies.study_result import OK, StudyResult
 
 
 def _g(x: float, digits: int = 5) -> str:
@@ -175,7 +175,7 @@ def convergence(
     if ok.sum() < 4:
         return [], [], {}, math.nan
     ns, se = st.standard_errors(y[ok])
-    u = study_unit_points(result)[ok]
+    u = result.unit_points()[ok]
     comparison, r2 = st.surrogate_convergence(u, y[ok], ns, seed=result.spec.seed)
     return ns, se, comparison, r2
 

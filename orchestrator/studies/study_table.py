@@ -19,9 +19,31 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Protocol
 
 from orchestrator.signals import SETTABLE, signal_setting
+
+
+class SceneChecks(Protocol):
+    """What the [study] table is read with: the scene loader's checks
+    (``orchestrator.scenario``), each failure a ScenarioError naming the file and the key."""
+
+    def fail(self, key: str, message: str) -> Exception: ...
+
+    def table(self, node: Any, key: str) -> dict[str, Any]: ...
+
+    def check_keys(self, node: dict[str, Any], key: str, allowed: set[str]) -> None: ...
+
+    def quantity(self, value: Any, key: str, unit: str) -> float: ...
+
+    def swept_unit(self, dotted: str, fmus: dict[str, Any], key: str = ...) -> str | None:
+        """The SI unit of a key a study may set (None: a plain value)."""
+        ...
+
+    def key_variables(self, dotted: str, fmus: dict[str, Any]) -> list[tuple[str, str, str]]:
+        """The (instance, "parameters" or "inputs", variable) a key sets."""
+        ...
+
 
 SAMPLING_METHODS = ("sobol", "monte-carlo")
 DISTRIBUTIONS = ("band", "normal", "uniform", "lognormal", "discrete")
@@ -110,7 +132,7 @@ class StudySpec:
     limits: tuple[AcceptanceLimit, ...]
 
 
-def parse_study(loader: Any, node: Any, fmus: dict[str, Any]) -> StudySpec:
+def parse_study(loader: SceneChecks, node: Any, fmus: dict[str, Any]) -> StudySpec:
     """The ``[study]`` table, checked against the scene's FMUs.  ``loader`` is the scene
     loader (``fail``, ``table``, ``check_keys``, ``quantity``, ``swept_unit``)."""
     node = loader.table(node, "study")
@@ -155,14 +177,14 @@ def parse_study(loader: Any, node: Any, fmus: dict[str, Any]) -> StudySpec:
     return StudySpec(inputs, samples, seed, sampling, tuple(quantities), limits)
 
 
-def _positive_int(loader: Any, node: dict[str, Any], key: str, default: int) -> int:
+def _positive_int(loader: SceneChecks, node: dict[str, Any], key: str, default: int) -> int:
     value = node.get(key, default)
     if isinstance(value, bool) or not isinstance(value, int) or value < 1:
         raise loader.fail(f"study.{key}", f"expected a positive integer, got {value!r}")
     return value
 
 
-def _input(loader: Any, entry: Any, where: str, fmus: dict[str, Any]) -> StudyInput:
+def _input(loader: SceneChecks, entry: Any, where: str, fmus: dict[str, Any]) -> StudyInput:
     entry = loader.table(entry, where)
     loader.check_keys(entry, where, _INPUT_KEYS)
     keys = entry.get("key")
@@ -192,7 +214,12 @@ def _input(loader: Any, entry: Any, where: str, fmus: dict[str, Any]) -> StudyIn
 
 
 def _distribution(
-    loader: Any, entry: dict[str, Any], where: str, unit: str, key: str, fmus: dict[str, Any]
+    loader: SceneChecks,
+    entry: dict[str, Any],
+    where: str,
+    unit: str,
+    key: str,
+    fmus: dict[str, Any],
 ) -> tuple[str, tuple[float, ...]]:
     def q(k: str) -> float:
         if k not in entry:
@@ -262,7 +289,7 @@ def _distribution(
     )
 
 
-def _band(loader: Any, text: Any, key: str, unit: str, nominal: float) -> float:
+def _band(loader: SceneChecks, text: Any, key: str, unit: str, nominal: float) -> float:
     """Half width of a symmetric band "±0.001 in" / "+-0.001 in" / "±5 %", in SI."""
     if not isinstance(text, str):
         raise loader.fail(key, f"expected a string such as '±0.001 in' or '±5 %', got {text!r}")
@@ -285,17 +312,16 @@ def _band(loader: Any, text: Any, key: str, unit: str, nominal: float) -> float:
     return half
 
 
-def _scene_value(loader: Any, key: str, fmus: dict[str, Any], where: str) -> float:
+def _scene_value(loader: SceneChecks, key: str, fmus: dict[str, Any], where: str) -> float:
     """The scene's own value of an FMU parameter or input (the nominal of a band)."""
-    parts = key.split(".", 3)
-    if len(parts) == 4 and parts[0] == "fmus" and parts[1] in fmus:
-        spec = fmus[parts[1]]
-        given = spec.parameters if parts[2] == "parameters" else spec.inputs
-        shorthand = signal_setting(spec, parts[3]) if parts[2] == "inputs" else None
+    for instance, kind, name in loader.key_variables(key, fmus)[:1]:
+        spec = fmus[instance]
+        given = spec.parameters if kind == "parameters" else spec.inputs
+        shorthand = signal_setting(spec, name) if kind == "inputs" else None
         if shorthand is not None:  # a signal's key, e.g. a step's height "u_s.to"
             value = shorthand[2].settings.get(shorthand[1])
         else:
-            value = given.get(parts[3], spec.model.variables[parts[3]].start)
+            value = given.get(name, spec.model.variables[name].start)
         try:
             return float(value)
         except (TypeError, ValueError):
@@ -305,19 +331,16 @@ def _scene_value(loader: Any, key: str, fmus: dict[str, Any], where: str) -> flo
     )
 
 
-def _check_range(loader: Any, spec: StudyInput, where: str, fmus: dict[str, Any]) -> None:
+def _check_range(loader: SceneChecks, spec: StudyInput, where: str, fmus: dict[str, Any]) -> None:
     """A distribution bounded on a side stays within the range the FMU declares there (an
     unbounded one may reach past it: those samples fail, and are counted, at run time)."""
     low, high = spec.support
-    for key in spec.keys:
-        parts = key.split(".", 3)
-        if len(parts) != 4 or parts[0] != "fmus":
-            continue
-        shorthand = signal_setting(fmus[parts[1]], parts[3])
+    targets = [(key, *target) for key in spec.keys for target in loader.key_variables(key, fmus)]
+    for key, instance, kind, name in targets:
+        shorthand = signal_setting(fmus[instance], name) if kind == "inputs" else None
         if shorthand is not None and SETTABLE[shorthand[1]] != "value":
             continue  # a signal's time: the run checks it
-        name = shorthand[0] if shorthand is not None else parts[3]
-        var = fmus[parts[1]].model.variables[name]
+        var = fmus[instance].model.variables[shorthand[0] if shorthand is not None else name]
         if var.min is not None and math.isfinite(low) and low < var.min:
             raise loader.fail(
                 where, f"reaches {low:.6g} {spec.unit}, below {key}'s minimum {var.min:g}"
@@ -328,7 +351,7 @@ def _check_range(loader: Any, spec: StudyInput, where: str, fmus: dict[str, Any]
             )
 
 
-def _limits(loader: Any, node: Any, quantities: list[str]) -> tuple[AcceptanceLimit, ...]:
+def _limits(loader: SceneChecks, node: Any, quantities: list[str]) -> tuple[AcceptanceLimit, ...]:
     node = loader.table(node, "study.limits")
     out = []
     for quantity, entry in node.items():

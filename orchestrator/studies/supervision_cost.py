@@ -17,7 +17,7 @@ from pathlib import Path
 from fmus.build import build_fmu
 from orchestrator.fmu_instance import FmuInstance
 from orchestrator.recorder import Recorder
-from orchestrator.studies.benchmarks import SCENARIOS, _best_per_call
+from orchestrator.studies.timing import SCENARIOS, best_per_call
 
 
 def _do_step_costs(n: int) -> tuple[float, float]:
@@ -44,8 +44,8 @@ def _do_step_costs(n: int) -> tuple[float, float]:
 
     best = [float("inf"), float("inf")]
     for _ in range(3):  # interleaved: a loaded machine drifts
-        best[0] = min(best[0], _best_per_call(unrecorded, n))
-        best[1] = min(best[1], _best_per_call(recorded, n))
+        best[0] = min(best[0], best_per_call(unrecorded, n))
+        best[1] = min(best[1], best_per_call(recorded, n))
     fmu.close()
     return best[0], best[1]
 
@@ -60,7 +60,7 @@ def _row_costs(n: int, columns: int = 8) -> tuple[float, float]:
             for _ in range(count):
                 rec.row(row)
 
-        line = _best_per_call(line_buffered, n)
+        line = best_per_call(line_buffered, n)
         rec._file.close()
         # The same writer on a block-buffered file: the baseline.
         rec._file = open(Path(tmp) / "block.csv", "w", newline="")  # noqa: SIM115
@@ -68,7 +68,7 @@ def _row_costs(n: int, columns: int = 8) -> tuple[float, float]:
 
         rec._writer = csv.writer(rec._file)
         rec.rows.clear()
-        block = _best_per_call(line_buffered, n)
+        block = best_per_call(line_buffered, n)
         rec.close({})
     return block, line
 

@@ -21,7 +21,6 @@ import json
 import math
 import os
 import time
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -31,51 +30,12 @@ from orchestrator.errors import ScenarioError
 from orchestrator.interrupt import catching_signals
 from orchestrator.progress import ProgressBar
 from orchestrator.provenance import source_changed, source_commit
-from orchestrator.scenario import Scene, load_scene
+from orchestrator.scenario import load_scene
 from orchestrator.studies.jobs import Job, JobResult, iter_jobs
-from orchestrator.studies.sampling import draw, unit_points
+from orchestrator.studies.sampling import draw
+from orchestrator.studies.study_report import write_markdown, write_plot
+from orchestrator.studies.study_result import FAILED, NO_VALUE, NOT_ARMED, OK, Sample, StudyResult
 from orchestrator.studies.study_table import MAX_SAMPLES, StudySpec
-
-OK = "ok"  # every quantity has a value
-NOT_ARMED = "not-armed"  # the run ended without arming (the scene analysis says why)
-NO_VALUE = "no-value"  # completed, but a quantity could not be computed
-FAILED = "failed"  # the run failed, or the scene refused the sample's values
-
-
-@dataclass
-class Sample:
-    index: int
-    inputs: list[float]  # SI, in the order of the study's inputs
-    status: str
-    values: dict[str, float]  # quantity -> value (NaN when none)
-    reason: str = ""
-
-
-@dataclass
-class StudyResult:
-    scene: Scene
-    spec: StudySpec
-    requested: int  # samples asked for
-    samples: list[Sample]  # recorded, in sample order
-    output_dir: Path
-    wall_time: float  # of this invocation
-    ran: int  # samples run by this invocation
-    workers: str
-    interrupted: int | None = None  # the signal that stopped the study
-    units: dict[str, str] = field(default_factory=dict)
-    invocations: list[dict[str, Any]] = field(default_factory=list)  # runs.json: every
-    # invocation of the study on this directory (samples run, wall time, where)
-    notes: list[str] = field(default_factory=list)  # what was adjusted (workers capped)
-    stopped: str | None = None  # why the study stopped early (its first samples all failed)
-
-    def values(self, quantity: str) -> np.ndarray:
-        """The quantity over the samples that gave every quantity (status ok)."""
-        return np.array([s.values[quantity] for s in self.samples if s.status == OK])
-
-    def inputs(self) -> np.ndarray:
-        """(samples ok, inputs) input values of the samples that gave every quantity."""
-        rows = [s.inputs for s in self.samples if s.status == OK]
-        return np.array(rows).reshape(len(rows), len(self.spec.inputs))
 
 
 def csv_header(spec: StudySpec) -> list[str]:
@@ -222,8 +182,6 @@ def run_study(
         notes,
         early.stopped,
     )
-    from orchestrator.studies.study_report import write_markdown, write_plot
-
     write_markdown(result, out_dir / "study.md")
     write_plot(result, out_dir / "study.png")
     return result
@@ -276,7 +234,7 @@ def _sample(k: int, inputs: np.ndarray, outcome: Any, spec: StudySpec) -> Sample
         return Sample(k, row, NOT_ARMED, values, str(why))
     missing = [q for q in spec.quantities if not math.isfinite(values[q])]
     if missing:
-        notes = outcome.stats.get("warnings", [])
+        notes = [*outcome.notes, *outcome.stats.get("warnings", [])]
         why = f"no value of {', '.join(missing)}" + (f" ({notes[0]})" if notes else "")
         return Sample(k, row, NO_VALUE, values, why)
     return Sample(k, row, OK, values)
@@ -398,13 +356,3 @@ def _saved_units(out_dir: Path, done: dict[int, Sample], spec: StudySpec) -> dic
             continue
         return {q: headline.get(q, {}).get("unit", "") for q in spec.quantities}
     return {}
-
-
-def study_unit_points(result: StudyResult) -> np.ndarray:
-    """The unit-cube points of the samples that gave every quantity (for the convergence
-    comparison, which refits the results over them)."""
-    spec = result.spec
-    count = max([result.requested, *(s.index + 1 for s in result.samples)])
-    u = unit_points(count, len(spec.inputs), spec.sampling, spec.seed)
-    ok = [s.index for s in result.samples if s.status == OK]
-    return u[ok]

@@ -2,10 +2,9 @@
 libcosim's fixed-step run of the exported system, against the monolithic reference,
 beside our own fixed-step Jacobi and the regime-aware master.
 
-Turns to arm = arming time x spin / 2 pi, the arming time being where the escape wheel
-angle ``train.phi`` first reaches the arming angle (Lowen & Tepper 1982: 1485 deg of
-escape wheel), interpolated linearly within the step that crosses it, as the M739
-analysis does for fixed-step masters.
+Turns to arm are the M739 analysis's (``orchestrator.scenes.m739.report``): the arming
+time is where the escape-wheel angle first reaches the arming angle (Lowen & Tepper 1982:
+1485 deg of escape wheel), interpolated linearly within the step that crosses it.
 
 ``python -m orchestrator.studies.tool_cost [SCENE] [--steps 1e-6,1e-5]`` prints the table.
 """
@@ -13,7 +12,6 @@ analysis does for fixed-step masters.
 from __future__ import annotations
 
 import argparse
-import math
 import tempfile
 import time
 from dataclasses import dataclass
@@ -21,8 +19,9 @@ from pathlib import Path
 
 import numpy as np
 
-from orchestrator.run import reference_of, run_scene
+from orchestrator.run import RunResult, reference_of, run_scene
 from orchestrator.scenario import Scene, load_scene, read_toml, scene_from_table
+from orchestrator.scenes.m739.report import arming_time, instance_names, turns_to_arm
 from orchestrator.studies.crosscheck import grid_steps, run_tool
 
 SCENE = Path(__file__).resolve().parents[2] / "scenarios" / "m739.toml"
@@ -37,17 +36,10 @@ class CostRow:
     wall_time: float
 
 
-def turns_to_arm(scene: Scene, t: np.ndarray, phi: np.ndarray) -> float | None:
+def turns(scene: Scene, t: np.ndarray, phi: np.ndarray) -> float | None:
     """Turns to arm from an escape-wheel angle history (None: the angle is not reached)."""
-    threshold = scene.stop_when.threshold
-    crossed = np.nonzero(phi >= threshold)[0]
-    if not len(crossed):
-        return None
-    k = int(crossed[0])
-    t_arm = t[k]
-    if k > 0 and phi[k] != threshold:
-        t_arm = t[k - 1] + (t[k] - t[k - 1]) * (threshold - phi[k - 1]) / (phi[k] - phi[k - 1])
-    return float(t_arm) * abs(scene.fmus["train"].parameters["spin"]) / (2.0 * math.pi)
+    t_arm = arming_time(scene, t, phi)
+    return None if t_arm is None else turns_to_arm(scene, t_arm)
 
 
 def measure(
@@ -56,6 +48,7 @@ def measure(
     """(reference turns, rows): libcosim and our Jacobi at each fixed step over ``span``
     seconds, and the regime-aware master as the scene sets it."""
     base = load_scene(path)
+    wheel = f"{instance_names(base)[0]}.phi"  # the escape-wheel angle
     reference = reference_of(base).headline["turns_to_arm"]
     rows = []
 
@@ -68,14 +61,12 @@ def measure(
             # Only the angle is recorded (and so no analysis): the runs time the coupling.
             raw = read_toml(path)
             raw.pop("report", None)
-            raw["output"]["record"] = ["train.phi"]
+            raw["output"]["record"] = [wheel]
             fixed = {"master.algorithm": "jacobi", "master.step": h, "scene.stop": span}
             scene = scene_from_table(path, raw, fixed)
             theirs = run_tool(scene, "libcosim", grid_steps(scene, span), Path(scratch) / f"{h}")
             t, phi = theirs.data[:, 0], theirs.data[:, 1]
-            rows.append(
-                row("libcosim fixed step", h, turns_to_arm(scene, t, phi), theirs.wall_time)
-            )
+            rows.append(row("libcosim fixed step", h, turns(base, t, phi), theirs.wall_time))
             started = time.perf_counter()
             ours = run_scene(
                 scene,
@@ -84,8 +75,7 @@ def measure(
                 compare_reference=False,
             )
             wall = time.perf_counter() - started
-            turns = turns_to_arm(scene, ours.signal("time"), ours.signal("train.phi"))
-            rows.append(row("mechcosim Jacobi", h, turns, wall))
+            rows.append(row("mechcosim Jacobi", h, turns(base, *_wheel(ours, wheel)), wall))
         started = time.perf_counter()
         ours = run_scene(
             base,
@@ -94,9 +84,14 @@ def measure(
             compare_reference=False,
         )
         wall = time.perf_counter() - started
-        turns = turns_to_arm(base, ours.signal("time"), ours.signal("train.phi"))
-        rows.append(row(f"mechcosim {base.master.algorithm}", None, turns, wall))
+        rows.append(
+            row(f"mechcosim {base.master.algorithm}", None, turns(base, *_wheel(ours, wheel)), wall)
+        )
     return reference, rows
+
+
+def _wheel(result: RunResult, wheel: str) -> tuple[np.ndarray, np.ndarray]:
+    return result.signal("time"), result.signal(wheel)
 
 
 def main(argv: list[str] | None = None) -> None:

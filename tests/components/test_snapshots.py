@@ -5,13 +5,13 @@ from __future__ import annotations
 import pytest
 
 from components.base import Component, SnapshotPlan
-from fmus.registry import FMU_WRAPPERS
+from fmus.registry import FMU_RECORDS
 
 #: Every FMU's component that snapshots by sharing everything (an empty plan).
 SHARED = sorted(
     {
         cls
-        for cls in (w.component_class() for w in FMU_WRAPPERS.values())
+        for cls in (w.component_class for w in FMU_RECORDS.values())
         if cls.SNAPSHOT == SnapshotPlan()
     },
     key=lambda cls: cls.__name__,

@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 from fmpy import read_model_description, simulate_fmu
 
-import fmus.build as build
+import fmus.registry as registry
 from fmus.build import build_fmu
 from orchestrator.errors import RunError, ScenarioError
 from orchestrator.fmu_instance import FmuInstance
@@ -209,13 +209,13 @@ def test_our_fmus_run_one_after_the_other_in_one_process() -> None:
 def test_two_builds_of_one_fmu_run_each_their_own_code(tmp_path, monkeypatch) -> None:
     plain = build_fmu("Inertia", tmp_path / "cache")
     changed = tmp_path / "components"
-    shutil.copytree(build.COMPONENTS_DIR, changed)
+    shutil.copytree(registry.COMPONENTS_DIR, changed)
     source = (changed / "rotational.py").read_text()
     assert "alpha = self.tau / self.J" in source
     (changed / "rotational.py").write_text(
         source.replace("alpha = self.tau / self.J", "alpha = 2.0 * self.tau / self.J")
     )
-    monkeypatch.setattr(build, "COMPONENTS_DIR", changed)
+    monkeypatch.setattr(registry, "COMPONENTS_DIR", changed)
     doubled = build_fmu("Inertia", tmp_path / "cache")
     assert doubled != plain
     instances = [FmuInstance(f"i{k}", path) for k, path in enumerate((plain, doubled))]

@@ -11,14 +11,22 @@ from pathlib import Path
 
 import pytest
 
-from fmus.documentation import DocumentationError, docstring_html, render_documentation
-from fmus.registry import FMU_WRAPPERS
-from orchestrator.scenario import component_class
+from components.base import Component
+from fmus.build import content_hash
+from fmus.documentation import docstring_html, render_documentation
+from fmus.example_scenes import ExampleSceneError
+from fmus.registry import FMU_RECORDS
 
 PROJECT_DIR = Path(__file__).resolve().parents[2]
 
-NAMES = sorted(FMU_WRAPPERS)
-REQUIREMENTS = ["numpy>=1.26", "scipy>=1.11"]
+NAMES = sorted(FMU_RECORDS)
+REQUIREMENTS = ["numpy>=1.26", "scipy>=1.11"]  # GearMesh's
+
+
+def component_class(name: str) -> type[Component]:
+    return FMU_RECORDS[name].component_class
+
+
 _VOID = {"br", "hr", "img", "input", "link", "meta", "wbr", "col", "area", "base", "source"}
 
 
@@ -78,8 +86,7 @@ class _Page(HTMLParser):
 
 @cache
 def _html(name: str) -> str:
-    wrapper = FMU_WRAPPERS[name]
-    return render_documentation(wrapper, component_class(name), REQUIREMENTS)
+    return render_documentation(FMU_RECORDS[name])
 
 
 @cache
@@ -125,7 +132,7 @@ def test_page_is_standalone_well_formed_html5(name: str) -> None:
 
 @pytest.mark.parametrize("name", NAMES)
 def test_names_identifier_and_the_wrapper_description(name: str) -> None:
-    script = FMU_WRAPPERS[name].script.read_text()
+    script = FMU_RECORDS[name].script.read_text()
     description = re.search(r'^\s+description = "(.*)"$', script, re.M).group(1)
     assert _page(name).lead == description.rstrip(".")
     assert f"<h1>{name}</h1>" in _html(name)
@@ -177,16 +184,16 @@ def test_lists_the_regimes_and_event_outputs(name: str) -> None:
             assert f"<code>{var.name}</code>" in html
 
 
-@pytest.mark.parametrize("name", [n for n in NAMES if FMU_WRAPPERS[n].examples])
+@pytest.mark.parametrize("name", [n for n in NAMES if FMU_RECORDS[n].example_paths])
 def test_lists_every_connection_of_each_example(name: str) -> None:
-    for example in FMU_WRAPPERS[name].examples:
+    for example in FMU_RECORDS[name].example_paths:
         stem = example.rsplit("/", 1)[-1].removesuffix(".toml")
         rows = _rows(name, f"connections-{stem}", "connection")
         assert len(rows) == _connection_count(example), example
 
 
 def test_gear_train_lists_the_m739_connections_with_the_integer_one() -> None:
-    assert FMU_WRAPPERS["GearTrain"].examples == ("scenarios/m739.toml",)
+    assert FMU_RECORDS["GearTrain"].example_paths == ("scenarios/m739.toml",)
     expected = _connection_count("scenarios/m739.toml")
     assert expected == 11
     rows = _rows("GearTrain", "connections-m739", "connection")
@@ -196,13 +203,17 @@ def test_gear_train_lists_the_m739_connections_with_the_integer_one() -> None:
     integers = _rows("GearTrain", "connections-m739", "integer")
     assert [r[1] for r in integers] == ["verge.impact_count -> train.impact_count"]
     assert integers[0][2].startswith("Integer")
-    assert "<code>&quot;30000 rpm&quot;</code>" in _html("GearTrain")  # as the scene writes it
+    # The scene's values are not shown: they are no part of the FMU (see the hash test).
+    assert "30000 rpm" not in _html("GearTrain")
 
 
 def test_host_requirements_and_tool_commands() -> None:
-    html = _html("GearTrain")
+    assert FMU_RECORDS["GearMesh"].requirements() == REQUIREMENTS
     for line in REQUIREMENTS:
-        assert line.replace(">", "&gt;") in html
+        assert line.replace(">", "&gt;") in _html("GearMesh")
+    assert FMU_RECORDS["GearTrain"].requirements() == []
+    html = _html("GearTrain")
+    assert "No packages beyond the standard library" in html
     for text in (
         "MECHCOSIM_PYTHON=/path/to/venv/bin/python",
         "resources/python.txt",
@@ -222,21 +233,19 @@ def test_host_requirements_and_tool_commands() -> None:
 
 
 def test_a_build_without_the_loader_says_which_hosts_it_loads_in() -> None:
-    html = render_documentation(
-        FMU_WRAPPERS["GearTrain"], component_class("GearTrain"), REQUIREMENTS, loader=False
-    )
+    html = render_documentation(FMU_RECORDS["GearTrain"], loader=False)
     assert "pythonfmu's runtime alone" in html and "MECHCOSIM_PYTHON" not in html
 
 
 def test_a_missing_example_scene_is_an_error() -> None:
-    wrapper = dataclasses.replace(FMU_WRAPPERS["Inertia"], examples=("scenarios/nowhere.toml",))
-    with pytest.raises(DocumentationError, match="scenarios/nowhere.toml"):
-        render_documentation(wrapper, component_class("Inertia"), REQUIREMENTS)
+    record = dataclasses.replace(FMU_RECORDS["Inertia"], example_paths=("scenarios/nowhere.toml",))
+    with pytest.raises(ExampleSceneError, match="scenarios/nowhere.toml"):
+        render_documentation(record)
 
 
 def test_registry_examples_exist_and_instantiate_their_fmu() -> None:
-    for name, wrapper in FMU_WRAPPERS.items():
-        for example in wrapper.examples:
+    for name, record in FMU_RECORDS.items():
+        for example in record.example_paths:
             scene = tomllib.loads((PROJECT_DIR / example).read_text())
             assert name in {spec["component"] for spec in scene["fmus"].values()}, example
 
@@ -263,3 +272,24 @@ def test_docstrings_keep_lists_equations_and_literals() -> None:
     assert "<pre>J phi&#x27;&#x27; = T                      (1)</pre>" in html
     assert "<ul><li>first bullet continued</li><li>second</li></ul>" in html
     assert '<ol><li value="0">zero</li><li value="1">one</li></ol>' in html
+
+
+def test_editing_an_example_scenes_values_rebuilds_no_fmu(tmp_path) -> None:
+    """An FMU's identity is its code and declarations: the spin rate (or any value) an
+    example scene sets changes neither the build hash nor the documentation."""
+    scene = tmp_path / "m739.toml"
+    text = (PROJECT_DIR / "scenarios/m739.toml").read_text()
+    edits = [("30000 rpm", "20000 rpm"), ("mu = 0.1", "mu = 0.2"), ('"0.2 s"', '"1 s"')]
+    assert all(old in text for old, _ in edits)
+    for name in ("GearTrain", "VergeEscapement"):
+        # an absolute path stays itself under the project directory
+        record = dataclasses.replace(FMU_RECORDS[name], example_paths=(str(scene),))
+        scene.write_text(text)
+        before = content_hash(record), render_documentation(record)
+        for old, new in edits:
+            scene.write_text(text.replace(old, new))
+            assert (content_hash(record), render_documentation(record)) == before, new
+        # What the documentation shows of the scene, its connections, does count.
+        last = text[text.rindex("[[connections]]") : text.index("[master]")]
+        scene.write_text(text.replace(last, ""))
+        assert content_hash(record) != before[0]

@@ -7,11 +7,10 @@ from fmpy import read_model_description, simulate_fmu
 from fmpy.validation import validate_fmu
 
 from fmus.build import build_fmu, content_hash
-from fmus.registry import FMU_WRAPPERS
+from fmus.registry import FMU_RECORDS
 from orchestrator.fmu_checks import state_round_trip_problems
-from orchestrator.scenario import component_class
 
-NAMES = sorted(FMU_WRAPPERS)
+NAMES = sorted(FMU_RECORDS)
 
 
 @pytest.mark.parametrize("name", NAMES)
@@ -23,7 +22,7 @@ def test_validates_with_no_message(name: str, fmu_cache) -> None:
 def test_declares_units_and_default_experiment(name: str, fmu_cache) -> None:
     md = read_model_description(str(build_fmu(name, fmu_cache)))
     assert md.defaultExperiment is not None
-    declared = {v.name: v.unit for v in component_class(name).VARIABLES}
+    declared = {v.name: v.unit for v in FMU_RECORDS[name].variables}
     for v in md.modelVariables:
         if v.type == "Real":
             expected = None if declared[v.name] == "1" else declared[v.name]
@@ -48,7 +47,7 @@ def test_build_is_cached_by_content(fmu_cache) -> None:
     mtime = first.stat().st_mtime_ns
     again = build_fmu("Inertia", fmu_cache)
     assert again == first and again.stat().st_mtime_ns == mtime
-    assert content_hash(FMU_WRAPPERS["Inertia"])[:16] in first.name
+    assert content_hash(FMU_RECORDS["Inertia"])[:16] in first.name
 
 
 def test_a_build_is_the_same_file_each_time(tmp_path) -> None:
@@ -77,19 +76,18 @@ def test_many_instances_in_one_process(fmu_cache) -> None:
 def test_the_code_an_fmu_packs_follows_edits(tmp_path, monkeypatch) -> None:
     # The import scan is kept per file version: an edit that adds an import is seen at once
     # (same second, other size), and nothing is scanned again while nothing changes.
-    from types import SimpleNamespace
+    import fmus.registry as registry
 
-    import fmus.build as build
-
-    monkeypatch.setattr(build, "COMPONENTS_DIR", tmp_path)
+    monkeypatch.setattr(registry, "COMPONENTS_DIR", tmp_path)
     (tmp_path / "__init__.py").write_text("")
     (tmp_path / "b.py").write_text("X = 1\n")
     a = tmp_path / "a.py"
     a.write_text("Y = 2\n")
-    wrapper = SimpleNamespace(component="components.a.A")
-    assert [p.name for p in build.component_modules(wrapper)] == ["__init__.py", "a.py"]
+    component = "components.a.A"
+    assert [p.name for p in registry.component_modules(component)] == ["__init__.py", "a.py"]
     a.write_text("from .b import X\n")
-    assert [p.name for p in build.component_modules(wrapper)] == ["__init__.py", "a.py", "b.py"]
-    scans = build._relative_imports.cache_info().misses
-    build.component_modules(wrapper)
-    assert build._relative_imports.cache_info().misses == scans
+    modules = [p.name for p in registry.component_modules(component)]
+    assert modules == ["__init__.py", "a.py", "b.py"]
+    scans = registry._relative_imports.cache_info().misses
+    registry.component_modules(component)
+    assert registry._relative_imports.cache_info().misses == scans

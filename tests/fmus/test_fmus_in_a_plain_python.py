@@ -21,7 +21,7 @@ from pathlib import Path
 import pytest
 
 from fmus.build import build_fmu
-from fmus.registry import FMU_WRAPPERS
+from fmus.registry import FMU_RECORDS
 
 pytestmark = pytest.mark.slow
 
@@ -83,7 +83,7 @@ def plain_python(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 
 def test_every_fmu_runs_in_a_plain_python(plain_python: Path, tmp_path: Path) -> None:
-    fmus = {name: build_fmu(name) for name in sorted(FMU_WRAPPERS)}
+    fmus = {name: build_fmu(name) for name in sorted(FMU_RECORDS)}
     python = plain_python
     numpy_only = [p for p in fmus.values() if all("scipy" not in r for r in requirements(p))]
     needs_scipy = [p for p in fmus.values() if p not in numpy_only]

@@ -23,15 +23,15 @@ from typing import Any
 import pytest
 
 from components.base import Component, Variable
-from fmus.registry import FMU_WRAPPERS
+from fmus.registry import FMU_RECORDS
 from orchestrator.units import to_si
 
 SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
-COMPONENTS = sorted(FMU_WRAPPERS)
+COMPONENTS = sorted(FMU_RECORDS)
 
 
 def component_class(name: str) -> type[Component]:
-    return FMU_WRAPPERS[name].component_class()
+    return FMU_RECORDS[name].component_class
 
 
 def within(var: Variable, value: float) -> bool:
@@ -109,7 +109,7 @@ def test_scenario_values_were_found() -> None:
     wheres = [w for w, *_ in SCENARIO_VALUES]
     assert any(":sweep.values:" in w for w in wheres)
     assert any(":sweep.series[" in w for w in wheres)
-    assert {c for _, c, _, _ in SCENARIO_VALUES} <= set(FMU_WRAPPERS)
+    assert {c for _, c, _, _ in SCENARIO_VALUES} <= set(FMU_RECORDS)
 
 
 @pytest.mark.parametrize(
@@ -321,7 +321,7 @@ TRAIN_SCALES = {
 
 
 def test_every_registry_component_has_a_feedthrough_case() -> None:
-    assert set(FEEDTHROUGH_CASES) == set(FMU_WRAPPERS)
+    assert set(FEEDTHROUGH_CASES) == set(FMU_RECORDS)
 
 
 def same(a: float, b: float) -> bool:

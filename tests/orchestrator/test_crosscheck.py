@@ -72,7 +72,15 @@ def test_a_disagreement_is_measured_relative_to_the_signal_scale() -> None:
     t = np.arange(0, 11) * scene.master.step
     ours_data = np.column_stack([t, 2.0 + 0 * t, 0 * t])
     ours = RunResult(
-        scene, "completed", "", ["time", "a.w", "b.w"], ours_data, [], None, {}, Path()
+        scene=scene,
+        status="completed",
+        message="",
+        header=["time", "a.w", "b.w"],
+        data=ours_data,
+        events=[],
+        stats=None,
+        headline={},
+        output_dir=Path(),
     )
     theirs_rows = ours_data[1:].copy()
     theirs_rows[4, 1] += 3e-9  # 1.5e-9 of a.w's scale 2

@@ -98,8 +98,7 @@ def test_trajectory_error_only_where_run_and_reference_overlap() -> None:
 def test_stalled_m739_reports_no_trajectory_error_instead_of_extrapolating(
     tmp_path: Path,
 ) -> None:
-    stall = {f"fmus.{k}": 0.18 for k in ("train.parameters.mu", "verge.parameters.mu")}
-    stall |= {"fmus.verge.parameters.mu1": 0.18, "scene.stop": "20 ms"}
+    stall = {"parameters.mu": 0.18, "fmus.verge.parameters.mu1": 0.18, "scene.stop": "20 ms"}
     result = run_scene(load_scene(M739, stall), output_dir=tmp_path, show_progress=False)
     assert result.status == "completed"
     assert "stalled" in result.headline["not_armed_reason"]["value"]
@@ -136,11 +135,11 @@ def test_press_feed_shorter_than_a_cycle_says_what_is_missing(tmp_path: Path) ->
     assert any("less than one crank cycle" in n for n in result.notes), result.notes
     summary = json.loads((tmp_path / "summary.json").read_text())
     assert "energy_residual" in summary["headline"] and summary["notes"] == result.notes
+    assert "warnings" not in summary["stats"]  # the notes once, not again as the master's
 
 
 def test_m739_without_spin_has_no_reference_trajectory_but_ends(tmp_path: Path) -> None:
-    spin0 = {f"fmus.{k}.parameters.spin": "0 rpm" for k in ("train", "verge")}
-    scene = load_scene(M739, spin0 | {"scene.stop": "5 ms"})
+    scene = load_scene(M739, {"parameters.spin": "0 rpm", "scene.stop": "5 ms"})
     result = run_scene(scene, output_dir=tmp_path, show_progress=False)
     assert result.status == "completed"
     assert "trajectory_error" in result.accuracy  # KeyError 't' before
@@ -216,13 +215,17 @@ def test_option_values_checked_at_load(scene: Path, key: str, value, fragment: s
         (TWO, {"output.directory": ""}, "output.directory", "expected a directory"),
         (TWO, {"master.step": "1e-12 s"}, "master.step", "--force"),
         (M739, {"master.step": "1e-15 s"}, "master.step", "--force"),
+        # a shared parameter is stated once: the old per-FMU key names the new one
         (
             M739,
-            {"fmus.verge.parameters.spin": "20000 rpm"},
+            {"fmus.verge.parameters.spin": "2e4 rpm"},
             "fmus.verge.parameters.spin",
             "spin rate",
         ),
-        (M739, {"fmus.train.parameters.spin": "0 rpm"}, "fmus.verge.parameters.spin", "differs"),
+        (M739, {"fmus.train.parameters.mu": 0.2}, "fmus.train.parameters.mu", "as parameters.mu"),
+        (M739, {"parameters.mu1": 0.2}, "parameters.mu1", "expected one of ['mu', 'spin']"),
+        (TWO, {"parameters.spin": "0 rpm"}, "parameters.spin", "no FMU of the scene shares"),
+        (M739, {"parameters.spin": "-1 rpm"}, "parameters.spin", "outside the valid range"),
     ],
 )
 def test_nonsense_refused_at_load(scene: Path, overrides: dict, key: str, fragment: str) -> None:

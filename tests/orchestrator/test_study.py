@@ -364,7 +364,7 @@ def test_sigint_stops_a_study_and_resume_finishes_it_identically(tmp_path: Path)
     env = {**os.environ, "PYTHONUNBUFFERED": "1"}
 
     def study(out: Path, *extra: str) -> list[str]:
-        return [sys.executable, "-m", "orchestrator.cli", "study", str(path), "--output",
+        return [sys.executable, "-m", "orchestrator", "study", str(path), "--output",
                 str(out), "--no-progress", "--workers", "2", *extra]  # fmt: skip
 
     whole = tmp_path / "whole"

@@ -77,8 +77,7 @@ def test_a_coarse_tolerance_stays_accurate(tmp_path, fmu_cache, default_run) -> 
 
 def test_jammed_train_does_not_arm_and_says_why(tmp_path, fmu_cache) -> None:
     friction = {
-        "fmus.train.parameters.mu": 0.3,
-        "fmus.verge.parameters.mu": 0.3,
+        "parameters.mu": 0.3,
         "fmus.verge.parameters.mu1": 0.3,
     }
     r = run(tmp_path, fmu_cache, "jam", **friction)

@@ -20,7 +20,6 @@ Instance names come from ``[report.options]`` (defaults "train" and "verge").
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 from typing import Any
 
@@ -33,13 +32,15 @@ from orchestrator.scenario import Scene
 from orchestrator.scenes.clock_train.monolithic import ARMING_ROTOR_ANGLE, run_clock_train
 from orchestrator.scenes.family import Quantity, Reference, quantity
 from orchestrator.scenes.m739.report import (
-    _names,
     _parameter,
     _why_not_armed,
+    crossing_time,
     escapement_arguments,
     escapement_figure,
+    instance_names,
     reference_from,
     save_figure,
+    turns_to_arm,
 )
 
 
@@ -51,33 +52,21 @@ def _arming(scene: Scene, train: str) -> tuple[str, float, bool]:
     return f"{train}.rotor_angle", ARMING_ROTOR_ANGLE, True
 
 
-def _crossing(t: np.ndarray, x: np.ndarray, level: float, rising: bool) -> float | None:
-    """First time x reaches level (linear within the step a fixed-step master overshoots)."""
-    hit = np.nonzero(x >= level if rising else x <= level)[0]
-    if not len(hit):
-        return None
-    k = int(hit[0])
-    if k == 0 or x[k] == level:
-        return float(t[k])
-    return float(t[k - 1] + (t[k] - t[k - 1]) * (level - x[k - 1]) / (x[k] - x[k - 1]))
-
-
 def analyse(
     scene: Scene, header: list[str], data: np.ndarray, options: dict[str, Any]
 ) -> dict[str, Quantity]:
     """Turns to arm (or why not), escape-wheel angle at arming, force maxima, impacts,
     tooth handovers."""
-    train, verge = _names(scene)
+    train, verge = instance_names(scene)
     col = {name: data[:, i] for i, name in enumerate(header)}
     t = col["time"]
-    spin = _parameter(scene, train, "spin")
     signal, level, rising = _arming(scene, train)
     out: dict[str, Any] = {}
-    t_arm = _crossing(t, col[signal], level, rising) if signal in col else None
+    t_arm = crossing_time(t, col[signal], level, rising) if signal in col else None
     if t_arm is not None:
         out["armed"] = quantity(1.0, "1")
         out["arming_time"] = quantity(t_arm, "s")
-        out["turns_to_arm"] = quantity(t_arm * abs(spin) / (2.0 * math.pi), "1")
+        out["turns_to_arm"] = quantity(turns_to_arm(scene, t_arm), "1")
         out["phi_at_arming"] = quantity(float(np.interp(t_arm, t, col[f"{train}.phi"])), "rad")
     else:
         out["armed"] = quantity(0.0, "1")
@@ -95,7 +84,7 @@ def analyse(
 
 def reference(scene: Scene) -> Reference:
     """The monolithic clock-train S&A with the scene's physics, as the yardstick."""
-    train, verge = _names(scene)
+    train, verge = instance_names(scene)
     signal, level, _ = _arming(scene, train)
     if signal != f"{train}.rotor_angle":
         raise ValueError(
@@ -119,7 +108,7 @@ def reference(scene: Scene) -> Reference:
 def plot(scene: Scene, header: list[str], data: np.ndarray, path: Path) -> None:
     """Verge and escape-wheel motion over the first cycles, with the train's speed ratio and
     mesh efficiencies."""
-    train, _ = _names(scene)
+    train, _ = instance_names(scene)
     fig, axes, (ms, col) = escapement_figure(scene, header, data, extra_panels=1)
     if f"{train}.speed_ratio" in col:
         axes[3].plot(ms, col[f"{train}.speed_ratio"], label="speed ratio (wheel/rotor)")

@@ -26,10 +26,10 @@ import numpy as np
 from components.event_integration import StepControl, advance
 from components.gear_train import INDEXING_AS_RUN, INDEXING_PHYSICAL, TrainPhysics
 from components.m739_data import LBF, M739, M739Data, rpm_to_rad_s
-from components.verge_escapement import REGIME_NAMES, STATE_SCALES, VergeConstants, VergeCore
+from components.verge_escapement import STATE_SCALES, VergeConstants, VergeCore
 
 #: Relative local error tolerance of the monolithic integration: turns to arm move by less
-#: than 1e-7 relative when it is tightened tenfold (tests/test_m739_physics.py).
+#: than 1e-7 relative when it is tightened tenfold (tests/components/test_m739_physics.py).
 REFERENCE_TOLERANCE = 1.0e-9
 #: The integration runs in stretches of this length (a stall or fault ends at the next).
 OUTPUT_CHUNK = 1.0e-3
@@ -250,8 +250,3 @@ def _finish(
         phi_end=y[0],
         series={n: np.asarray(v) for n, v in cols.items()},
     )
-
-
-def regime_name(code: int) -> str:
-    """Readable name of a VergeEscapement regime code."""
-    return REGIME_NAMES.get(code, str(code))

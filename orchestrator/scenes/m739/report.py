@@ -24,7 +24,8 @@ from orchestrator.scenes.family import Quantity, Reference, quantity
 from orchestrator.scenes.m739.monolithic import run_m739
 
 
-def _names(scene: Scene) -> tuple[str, str]:
+def instance_names(scene: Scene) -> tuple[str, str]:
+    """(gear train, verge) instances, from [report.options]."""
     o = scene.analysis_options
     return o.get("train", "train"), o.get("verge", "verge")
 
@@ -52,26 +53,41 @@ def _arming_angle(scene: Scene) -> float:
     return cond.threshold if cond is not None else M739.phi_cut
 
 
+def crossing_time(t: np.ndarray, x: np.ndarray, level: float, rising: bool = True) -> float | None:
+    """First time x reaches level (linear within the step a fixed-step master overshoots);
+    None: never."""
+    hit = np.nonzero(x >= level if rising else x <= level)[0]
+    if not len(hit):
+        return None
+    k = int(hit[0])
+    if k == 0 or x[k] == level:
+        return float(t[k])
+    return float(t[k - 1] + (t[k] - t[k - 1]) * (level - x[k - 1]) / (x[k] - x[k - 1]))
+
+
+def arming_time(scene: Scene, t: np.ndarray, phi: np.ndarray) -> float | None:
+    """When the escape-wheel angle ``phi`` first reaches the arming angle; None: never."""
+    return crossing_time(t, phi, _arming_angle(scene))
+
+
+def turns_to_arm(scene: Scene, t_arm: float) -> float:
+    """Turns of the projectile (at the train's spin) in ``t_arm`` seconds."""
+    train, _ = instance_names(scene)
+    return t_arm * abs(_parameter(scene, train, "spin")) / (2.0 * math.pi)
+
+
 def analyse(
     scene: Scene, header: list[str], data: np.ndarray, options: dict[str, Any]
 ) -> dict[str, Quantity]:
     """Turns to arm (or why not), arming time, force maxima by regime, impacts."""
-    train, verge = _names(scene)
+    train, verge = instance_names(scene)
     col = {name: data[:, i] for i, name in enumerate(header)}
-    t, phi = col["time"], col[f"{train}.phi"]
-    spin = _parameter(scene, train, "spin")
-    phi_cut = _arming_angle(scene)
     out: dict[str, Any] = {}
-    crossed = np.nonzero(phi >= phi_cut)[0]
-    if len(crossed):
-        k = int(crossed[0])
-        if k == 0 or phi[k] == phi_cut:
-            t_arm = t[k]
-        else:  # a fixed-step master stops past the angle: interpolate within the last step
-            t_arm = t[k - 1] + (t[k] - t[k - 1]) * (phi_cut - phi[k - 1]) / (phi[k] - phi[k - 1])
+    t_arm = arming_time(scene, col["time"], col[f"{train}.phi"])
+    if t_arm is not None:
         out["armed"] = quantity(1.0, "1")
         out["arming_time"] = quantity(t_arm, "s")
-        out["turns_to_arm"] = quantity(t_arm * abs(spin) / (2.0 * math.pi), "1")
+        out["turns_to_arm"] = quantity(turns_to_arm(scene, t_arm), "1")
     else:
         out["armed"] = quantity(0.0, "1")
         out["not_armed_reason"] = {"value": _why_not_armed(scene, col, train), "unit": ""}
@@ -96,7 +112,7 @@ def _why_not_armed(scene: Scene, col: dict[str, np.ndarray], train: str) -> str:
 
 def reference(scene: Scene) -> Reference:
     """The monolithic M739 model with the scene's physics, as the yardstick."""
-    train, verge = _names(scene)
+    train, verge = instance_names(scene)
     data = escapement_data(
         _parameter(scene, verge, "center_distance"),
         pallet_inertia=_parameter(scene, verge, "pallet_inertia"),
@@ -154,7 +170,7 @@ def escapement_figure(scene: Scene, header: list[str], data: np.ndarray, extra_p
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    train, verge = _names(scene)
+    train, verge = instance_names(scene)
     col = {name: data[:, i] for i, name in enumerate(header)}
     t = col["time"]
     window = t <= min(t[-1], 2.2e-3)
