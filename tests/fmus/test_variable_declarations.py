@@ -88,6 +88,18 @@ def scenario_parameter_values() -> Iterator[tuple[str, str, str, Any]]:
         for inst, table in fmus.items():
             for pname, value in table.get("parameters", {}).items():
                 yield f"{rel}:fmus.{inst}.parameters.{pname}", component[inst], pname, value
+
+        def takers(pname: str, component: dict[str, str] = component) -> list[str]:
+            """The components a shared [parameters] value reaches."""
+            return [
+                c
+                for c in component.values()
+                if pname in {v.name for v in component_class(c).variables("parameter")}
+            ]
+
+        for pname, value in raw.get("parameters", {}).items():
+            for c in takers(pname):
+                yield f"{rel}:parameters.{pname}", c, pname, value
         sweep = raw.get("sweep")
         if not sweep:
             continue
@@ -99,6 +111,9 @@ def scenario_parameter_values() -> Iterator[tuple[str, str, str, Any]]:
             parts = key.split(".")
             if len(parts) == 4 and parts[0] == "fmus" and parts[2] == "parameters":
                 yield f"{where}:{key}", component[parts[1]], parts[3], value
+            elif len(parts) == 2 and parts[0] == "parameters":
+                for c in takers(parts[1]):
+                    yield f"{where}:{key}", c, parts[1], value
 
 
 SCENARIO_VALUES = list(scenario_parameter_values())
