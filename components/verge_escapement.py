@@ -56,6 +56,7 @@ from typing import Any
 
 from .base import Component, ComponentError, SnapshotPlan, Variable, common_outputs
 from .escape_wheel import ESCAPE_WHEEL_PORT
+from .early_return import EARLY_RETURN_VARIABLES, UntilFirstEvent, reached
 from .event_integration import INTEGRATION_VARIABLES, advance, step_control
 from .m739_data import M739, M739Data
 from .verge_geometry import (
@@ -747,6 +748,10 @@ class VergeEscapement(Component):
     fired at the step start): keep the step, giving an impact to the train first.
     Energy: stored = 1/2 I_p psi_dot^2; the impact losses are booked here.
 
+    Early return (``components.early_return``): with the input ``early_return`` = 1 a step
+    ends just after its first event (regime change, impact, friction sign or branch: each
+    jumps T_esc or the impact outputs) and ``t_reached`` says where.
+
     Port ``escape_wheel``: angle and speed (in), torque T_esc (out), and the train's
     affine response (inertia J_ref, drive T_ref, load_factor c_load, impact_inertia J_stot).
     The other way the escapement is an affine load: T_esc = T_esc_static - J_esc phi_ddot
@@ -877,6 +882,14 @@ class VergeEscapement(Component):
             depends_on=_WHEEL_AND_TRAIN,
         ),
         Variable(
+            "phi_own",
+            "output",
+            "rad",
+            0.0,
+            "escape-wheel angle (own copy)",
+            depends_on=("phi",),
+        ),
+        Variable(
             "phi_dot_own",
             "output",
             "rad/s",
@@ -935,6 +948,7 @@ class VergeEscapement(Component):
             -1.0,
             "first regime change or impact of the last step that had one",
         ),
+        *EARLY_RETURN_VARIABLES,
         Variable(
             "J_load",
             "output",
@@ -962,6 +976,7 @@ class VergeEscapement(Component):
         self._g_end = self._core.indicators(self._y)
         self._cos0 = math.cos(k.gamma_pp - self._y[2] - self._core.psic)
         self.t_event = -1.0
+        self.t_reached = t0
         self._outputs(self._y)
 
     def _take_inputs(self) -> list[float]:
@@ -985,6 +1000,7 @@ class VergeEscapement(Component):
 
     def step(self, t: float, h: float) -> None:
         core = self._core
+        self.t_reached = t + h
         y = self._take_inputs()
         core.t_base = t
         core.t_mark = -1.0
@@ -999,12 +1015,14 @@ class VergeEscapement(Component):
             self._g_end = core.indicators(y)
             self._outputs(y)
             return
-        done = advance(core, y, h, self._control, self._h_next)
+        model = UntilFirstEvent(core) if self.early_return else core
+        done = advance(model, y, h, self._control, self._h_next)
         y, self._h_next = done.y, done.h_next
         if core.halted:
             raise ComponentError(f"VergeEscapement: {core.fault}")
         if core.t_mark >= 0.0:
             self.t_event = t + core.t_mark
+        self.t_reached = reached(t, h, model)
         self._y = y
         self._g_end = core.indicators(y)
         self._outputs(y)
@@ -1043,7 +1061,7 @@ class VergeEscapement(Component):
             self.ind_face_end, self.ind_gap = ind[IND_FACE_END], ind[IND_CONTACT]
         self.v_close = core.closing_speed(y)[0]
         self.phi_ddot = acc
-        self.phi_dot_own = y[1]
+        self.phi_own, self.phi_dot_own = y[0], y[1]
         self.psi_local = psi
         self.psi_dot = psi_d
         body = psi + core.psic - k.d.psic

@@ -516,7 +516,13 @@ def run_regime_aware(
             system, scene, scene.master.step, recorder, stats, progress, sequential=False
         )
         return
-    master = RegimeAwareMaster(
-        system, scene.master.settings, scene.start, scene.stop, recorder, stats
-    )
+    settings = scene.master.settings
+    if settings.single_pass:
+        from orchestrator.masters.single_pass import SinglePassMaster
+
+        master: RegimeAwareMaster = SinglePassMaster(
+            system, settings, scene.start, scene.stop, recorder, stats
+        )
+    else:
+        master = RegimeAwareMaster(system, settings, scene.start, scene.stop, recorder, stats)
     master.run(progress)

@@ -1,0 +1,327 @@
+"""The regime-aware master with one pass per macro step (``input_hold = "extrapolated"``).
+
+Each FMU is stepped once per macro step.  A held input is set to the mean over the step of
+its source's linear extrapolation from the last two exchange points (the inputs of one
+regime: after a switch the history restarts and the first step holds the values at its
+start).  After the step, the extrapolation is compared with what the sources actually did:
+the error estimate is the difference between the mean that was used and the trapezoidal
+mean of the actual start and end values, relative to each signal's running scale, as in
+Schierz, Arnold & Clauß, "Co-simulation with communication step size control in an FMI
+compatible master algorithm", 9th International Modelica Conference (2012).  A step is
+retaken only when that estimate exceeds the tolerance.
+
+Switches: an FMU that can end its step at its own first event (an Integer input
+``early_return``; it says how far it got in ``t_reached``) is stepped first with it set;
+the others are then stepped once, to that instant.  A switch that only an indicator or a
+reported event time of another FMU shows is located and landed on as in the midpoint
+master (rollback and a shorter pass).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from orchestrator.errors import RunError
+from orchestrator.masters.regime_aware import RegimeAwareMaster, _Snapshot
+
+#: Name of the Integer input by which an FMU offers to end a step at its first event, and
+#: of the output that says where it stopped.
+EARLY_RETURN_INPUT = "early_return"
+REACHED_OUTPUT = "t_reached"
+#: Suffix of the output by which an FMU reports its own copy of a sampled input.
+OWN_SUFFIX = "_own"
+
+
+class InputExtrapolation:
+    """Per exchanged Real signal: its value at the previous exchange point of this regime,
+    to extrapolate it linearly over the next step."""
+
+    def __init__(self, signals: list[tuple[int, int]]) -> None:
+        self.signals = signals
+        self.previous: dict[tuple[int, int], float] = {}
+        self.t_previous: float | None = None
+        self.slopes: dict[tuple[int, int], float] = {}
+        self.carried: dict[tuple[int, int], float] = {}
+
+    def reset(self) -> None:
+        """A switch: the values before it say nothing of those after."""
+        self.t_previous = None
+        self.slopes = {}
+        self.carried: dict[tuple[int, int], float] = {}
+
+    def carry(self) -> None:
+        """An internal event (a friction sign, a mesh piece): the signals jump but their
+        rates go on, so the next step extrapolates with the slopes of the last one."""
+        self.t_previous = None
+        self.carried = self.slopes
+
+    def prepare(self, t: float, values: list[list[float]]) -> None:
+        """Slopes for the step from t (values: those read at t)."""
+        if self.t_previous is None or t <= self.t_previous:
+            self.slopes, self.carried = self.carried, {}
+            return
+        dt = t - self.t_previous
+        prev = self.previous
+        self.slopes = {s: (values[s[0]][s[1]] - prev[s]) / dt for s in self.signals}
+
+    def accepted(self, t: float, values: list[list[float]]) -> None:
+        """The step from t was accepted without a switch: t is the previous point now."""
+        self.t_previous = t
+        self.previous = {s: values[s[0]][s[1]] for s in self.signals}
+
+    def mean(self, source: tuple[int, int], start: float, h: float) -> float:
+        """Mean over [t, t+h] of the extrapolated signal."""
+        return start + 0.5 * h * self.slopes.get(source, 0.0)
+
+    @property
+    def second_order(self) -> bool:
+        return bool(self.slopes)
+
+
+class SinglePassMaster(RegimeAwareMaster):
+    """One pass of every FMU per macro step, inputs extrapolated; see the module doc."""
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        system = self.system
+        averaged = sorted({src for inputs in self.held_inputs for src, avg in inputs if avg})
+        self.extrapolation = InputExtrapolation(averaged)
+        self.averaged = averaged
+        self.first_order = False
+        # FMUs that end a step at their first event: set them to do so, stepped first.
+        self.early: list[int] = []
+        self.reached_slot: dict[int, int] = {}
+        for i, (inst, model) in enumerate(zip(system.instances, system.models, strict=True)):
+            var = model.variables.get(EARLY_RETURN_INPUT)
+            out = model.variables.get(REACHED_OUTPUT)
+            if var is None or out is None or var.causality != "input":
+                continue
+            if any(c.target == (self.names[i], EARLY_RETURN_INPUT) for c in system.connections):
+                continue  # the scene drives it
+            inst.setter(inst.refs([EARLY_RETURN_INPUT]), integer=True)([1])
+            self.early.append(i)
+            self.reached_slot[i] = system.real_output_slot(i, REACHED_OUTPUT)
+        self.late = [i for i in range(len(self.names)) if i not in self.early]
+        # Sampled inputs whose receiver reports its own copy at the step end (an output
+        # named after the input with "_own"): (source, receiver's copy).  The copy
+        # follows the held inputs, the source the true ones: their difference at the step
+        # end is the coupling error the next step start discards.
+        self.copies: list[tuple[tuple[int, int], tuple[int, int]]] = []
+        for c, src in zip(system.connections, system.connection_sources, strict=True):
+            j = system.index[c.target[0]]
+            own = c.target[1] + OWN_SUFFIX
+            model = system.models[j]
+            if src is None or c.target[1] not in model.sampled or own not in model.variables:
+                continue
+            self.copies.append((src, (j, system.real_output_slot(j, own))))
+        # The held inputs of FMUs joined by such a copy are judged by it (their effect on
+        # the motion, not the size of their change); the others by their extrapolation.
+        covered = {j for (_, (j, _)) in self.copies} | {s[0] for (s, _) in self.copies}
+        self.averaged = sorted(
+            {
+                src
+                for i, inputs in enumerate(self.held_inputs)
+                if i not in covered
+                for src, avg in inputs
+                if avg
+            }
+        )
+        self.internal = False  # the last pass ended at an event that switched no regime
+        self.returned: set[int] = set()  # FMUs that ended the last pass at their own event
+        self.end_values: list[list[float]] = []
+        self.rate: dict[tuple[int, int], float] = {}  # largest rate of a copied source
+
+    # -- one pass -----------------------------------------------------------------------
+    def feeds_for(self, h: float, before: _Snapshot) -> list[list[float]]:
+        start = before.values
+        ex = self.extrapolation
+        return [
+            [
+                ex.mean((s, k), start[s][k], h) if averaged else start[s][k]
+                for (s, k), averaged in inputs
+            ]
+            for inputs in self.held_inputs
+        ]
+
+    def one_pass(self, t: float, h: float, before: _Snapshot, state: list[Any]) -> float:
+        """Step every FMU once from t: those that end at their first event first, each to
+        where the earliest so far stopped, then the others there.  An FMU stepped past an
+        event another one stopped at before it is stepped again to it (in scene order:
+        the cheaper first).  Returns the step taken."""
+        system = self.system
+        feeds = self.feeds_for(h, before)
+        for i in range(len(feeds)):
+            system.feed(i, feeds[i], before.ints)
+        h_end = h
+        returned = self.returned = set()
+        stepped: dict[int, float] = {}  # early FMU -> the step it took
+        pending = list(self.early)
+        while pending:
+            i = pending.pop(0)
+            if i in stepped:  # past the event another stopped at: back to t, once more
+                system.instances[i].set_state(state[i])
+                system.feed(i, self.feeds_for(h_end, before)[i], before.ints)
+                self.stats.rollbacks += 1
+            system.step(i, t, h_end)
+            self.stats.do_steps += 1
+            stepped[i] = h_end
+            system.read(i)
+            reached = system.values[i][self.reached_slot[i]]
+            if t < reached < t + h_end:
+                h_end = reached - t
+                returned.clear()
+                returned.add(i)
+                pending.extend(j for j in stepped if j != i and j not in pending)
+            else:
+                returned.discard(i)
+        if h_end < h:
+            # Held inputs over the shorter step: the means of the extrapolation over it.
+            feeds = self.feeds_for(h_end, before)
+            for i in self.late:
+                system.feed(i, feeds[i], before.ints)
+        for i in self.late:
+            system.step(i, t, h_end)
+        self.stats.do_steps += len(self.late)
+        system.read_all()
+        # The values at the step end with the inputs of the step (an impact not yet taken):
+        # what the error estimate compares the extrapolation with.
+        self.end_values = list(system.values)  # read() replaces the inner lists
+        self.refresh()
+        return h_end
+
+    def estimate(self, h: float, before: _Snapshot) -> float:
+        """Error ratio of the step just taken: the extrapolated mean against the
+        trapezoidal mean of each held signal's actual start and end values.  An FMU that
+        ended its step at its own event has its outputs of after the event there (they
+        jump at it): its signals are not compared on that step."""
+        ex, tol = self.extrapolation, self.cfg.tolerance
+        start, end = before.values, self.end_values
+        returned = self.returned
+        worst = 0.0
+        for s in self.averaged:
+            i, k = s
+            if i in returned:
+                continue
+            a, b = start[i][k], end[i][k]
+            scale = self.scale[s] = max(self.scale.get(s, 0.0), abs(a), abs(b))
+            if scale > 0.0:
+                miss = abs(ex.mean(s, a, h) - 0.5 * (a + b))
+                worst = max(worst, miss / (tol * scale))
+        # Copies as the receiver ended its step; sources as they are after the exchange
+        # at the end (a source that takes an impact from the receiver has taken it).  The
+        # mismatch is measured against how far the source moves in the step at its
+        # largest rate so far (error per unit step): the mismatches of the steps add up
+        # to at most the tolerance times the source's travel at that rate.
+        now = self.system.values
+        smooth = not returned  # an event's jump is no rate
+        for s, (j, k) in self.copies:
+            a, b = start[s[0]][s[1]], now[s[0]][s[1]]
+            rate = max(self.rate.get(s, 0.0), abs(b - a) / h)
+            if smooth:
+                self.rate[s] = rate
+            if rate > 0.0:
+                worst = max(worst, abs(end[j][k] - b) / (tol * rate * h))
+        blind = self.error_ratio(before, self.blind) if self.blind else 0.0
+        self.first_order = blind > worst or not ex.second_order
+        return max(worst, blind)
+
+    # -- main loop ----------------------------------------------------------------------
+    def run(self, progress) -> None:
+        cfg, system, stats, recorder = self.cfg, self.system, self.stats, self.recorder
+        control = self.control
+        t, stop = self.start, self.stop
+        h = cfg.first_step
+        recorder.row(system.record_row(t))
+        same_instant = 0
+        while t < stop - control.stop_slack * max(1.0, abs(stop)):
+            h = min(h, stop - t)
+            state = system.get_state()
+            before = self.snapshot()
+            self.extrapolation.prepare(t, before.values)
+            try:
+                h, te, ratio = self._attempt(t, h, before, state)
+            finally:
+                system.free_state(state)
+            t += h
+            stats.steps += 1
+            if te is None:
+                self.extrapolation.accepted(t - h, before.values)
+                stats.events += self.log_switches(t - h, before)
+                recorder.row(system.record_row(t))
+                h = min(cfg.max_step, h * control.grow(ratio, self.first_order))
+                self._remember_step(tuple(before.regimes), ratio, h)
+                same_instant = 0
+            else:
+                stats.iterations += self.settle() - 1
+                switches = self.log_switches(t, before)
+                if switches == 0 and self.internal:
+                    # An FMU ended its step at an internal event (a friction sign or a
+                    # branch: an output jumps) with no regime change: landed on, not logged.
+                    stats.extra["internal_events"] = stats.extra.get("internal_events", 0) + 1
+                else:
+                    stats.events += max(switches, 1)
+                recorder.row(system.record_row(t))
+                if self.internal:
+                    self.extrapolation.carry()
+                else:
+                    self.extrapolation.reset()
+                window = self.instant
+                same_instant = same_instant + 1 if h <= window else 0
+                if same_instant > cfg.max_events_per_step:
+                    raise RunError(
+                        f"chattering: {same_instant} switches within "
+                        f"{window:.1e} s of each other; last in {self._last_switch()}",
+                        t,
+                    )
+                h = self._restart_step(tuple(system.regimes()))
+            progress(t)
+            stop_indicator = system.stop_indicator()
+            if stop_indicator is not None and stop_indicator <= 0.0:
+                stats.extra["stopped_by_condition"] = True
+                return
+
+    def _attempt(
+        self, t: float, h: float, before: _Snapshot, state: list[Any]
+    ) -> tuple[float, float | None, float]:
+        """Passes from t until one is accepted: (h, switch time or None, error ratio)."""
+        cfg, control = self.cfg, self.control
+        last_ratio = None
+        stalled = 0
+        for _ in range(control.max_trials):
+            h_full = h
+            h = self.one_pass(t, h, before, state)
+            early = h < h_full
+            te = self.switch_time(t, h, before)
+            self.internal = False
+            if early and (te is None or te >= t + h - self._landing_window()):
+                self.internal = te is None
+                te = t + h  # an FMU ended its step on its own event
+            ratio = self.estimate(h, before)
+            if te is not None:
+                if t + h - te <= self._landing_window() or h <= cfg.min_step:
+                    if ratio > 1.0 and h > cfg.min_step:
+                        # The step onto the switch must pass the error test as well.
+                        h = max(cfg.min_step, h * control.shrink(ratio, self.first_order))
+                        self._rollback(state, before)
+                        last_ratio = None
+                        continue
+                    return h, te, ratio
+                h = max(te - t + 0.5 * cfg.event_tolerance, cfg.min_step)
+                self._rollback(state, before)
+                last_ratio = None
+                continue
+            if ratio > 1.0 and h > cfg.min_step:
+                as_large = last_ratio is not None and ratio > control.jump_ratio * last_ratio
+                stalled = stalled + 1 if as_large else 0
+                if stalled >= control.jump_shrinks:
+                    self.stats.extra["jumps"] = self.stats.extra.get("jumps", 0) + 1
+                    return h, t + h, ratio
+                last_ratio = ratio
+                h = max(cfg.min_step, h * control.shrink(ratio, self.first_order))
+                self._rollback(state, before)
+                continue
+            return h, None, ratio
+        raise RunError(
+            f"no acceptable step from here after {control.max_trials} trials (last h = {h:.3e} s)",
+            t,
+        )
