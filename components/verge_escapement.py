@@ -55,8 +55,8 @@ from collections.abc import Callable
 from typing import Any
 
 from .base import Component, ComponentError, SnapshotPlan, Variable, common_outputs
-from .escape_wheel import ESCAPE_WHEEL_PORT
 from .early_return import EARLY_RETURN_VARIABLES, UntilFirstEvent, reached
+from .escape_wheel import ESCAPE_WHEEL_PORT
 from .event_integration import INTEGRATION_VARIABLES, advance, step_control
 from .m739_data import M739, M739Data
 from .verge_geometry import (
