@@ -873,6 +873,12 @@ class VergeEscapement(Component):
             "escapement inertia felt at the wheel (coupled)",
             depends_on=_WHEEL_STATE,
         ),
+        # Over the last step, for a train stepped after the verge over the same interval:
+        # the escapement as the plain torque whose impulse the verge's wheel took (impacts
+        # aside: they reach the train as phi_dot_post), exact with early return.
+        Variable("T_esc_mean", "output", "N.m", 0.0, "T_esc over the last step, mean"),
+        Variable("T_esc_static_mean", "output", "N.m", 0.0, "= T_esc_mean (with J_esc_mean = 0)"),
+        Variable("J_esc_mean", "output", "kg.m2", 0.0, "0: the step mean is a plain torque"),
         Variable(
             "phi_ddot",
             "output",
@@ -1014,8 +1020,10 @@ class VergeEscapement(Component):
             self._y = y
             self._g_end = core.indicators(y)
             self._outputs(y)
+            self.T_esc_mean = self.T_esc_static_mean = self.T_esc
             return
         model = UntilFirstEvent(core) if self.early_return else core
+        w0, impacts, coupled = y[1], core.impacts, core.coupled
         done = advance(model, y, h, self._control, self._h_next)
         y, self._h_next = done.y, done.h_next
         if core.halted:
@@ -1023,9 +1031,19 @@ class VergeEscapement(Component):
         if core.t_mark >= 0.0:
             self.t_event = t + core.t_mark
         self.t_reached = reached(t, h, model)
+        # The mean escapement torque on the wheel over the step, from the held response:
+        # J_ref (w1 - w0) = (T_ref + c_load T_esc_mean) dt, w1 just before an impact.
+        w1 = core.last_impact[0] if core.impacts != impacts else y[1]
+        held = self._held
+        dt = self.t_reached - t
+        if coupled or core.coupled or core.impacts != impacts:
+            mean = (held.j_ref * (w1 - w0) / dt - held.t_ref) / held.c_load
+        else:
+            mean = 0.0  # free throughout (an early return ends at the first contact)
         self._y = y
         self._g_end = core.indicators(y)
         self._outputs(y)
+        self.T_esc_mean = self.T_esc_static_mean = mean
 
     def _resync_events(self, y: list[float]) -> list[float]:
         """Fire the events that the jump to the input state crossed (e.g. the tooth is

@@ -30,52 +30,79 @@ EARLY_RETURN_INPUT = "early_return"
 REACHED_OUTPUT = "t_reached"
 #: Suffix of the output by which an FMU reports its own copy of a sampled input.
 OWN_SUFFIX = "_own"
+#: Suffix of the output that is the mean of another over the last step.
+MEAN_SUFFIX = "_mean"
+
+
+import os
+
+RESTART = float(os.environ.get("SP_RESTART", "0.25"))
+ORDER = int(os.environ.get("SP_ORDER", "1"))
+MAX_ROUNDS = 4
+EXPONENT = float(os.environ.get("SP_EXP", "0.5"))
 
 
 class InputExtrapolation:
-    """Per exchanged Real signal: its value at the previous exchange point of this regime,
-    to extrapolate it linearly over the next step."""
+    """Per exchanged Real signal: its values at the last exchange points where it was
+    continuous, to extrapolate it over the next step by the polynomial through them
+    (Newton form: linear through one previous point, quadratic through two)."""
 
-    def __init__(self, signals: list[tuple[int, int]]) -> None:
+    def __init__(self, signals: list[tuple[int, int]], points: int = ORDER) -> None:
         self.signals = signals
-        self.previous: dict[tuple[int, int], float] = {}
-        self.t_previous: float | None = None
-        self.slopes: dict[tuple[int, int], float] = {}
+        self.points = points
+        self.history: dict[tuple[int, int], list[tuple[float, float]]] = {s: [] for s in signals}
+        #: per signal (first divided difference, second divided difference, t - t1)
+        self.coefficients: dict[tuple[int, int], tuple[float, float, float]] = {}
         self.carried: dict[tuple[int, int], float] = {}
-
-    def reset(self) -> None:
-        """A switch: the values before it say nothing of those after."""
-        self.t_previous = None
-        self.slopes = {}
-        self.carried: dict[tuple[int, int], float] = {}
-
-    def carry(self) -> None:
-        """An internal event (a friction sign, a mesh piece): the signals jump but their
-        rates go on, so the next step extrapolates with the slopes of the last one."""
-        self.t_previous = None
-        self.carried = self.slopes
 
     def prepare(self, t: float, values: list[list[float]]) -> None:
-        """Slopes for the step from t (values: those read at t)."""
-        if self.t_previous is None or t <= self.t_previous:
-            self.slopes, self.carried = self.carried, {}
-            return
-        dt = t - self.t_previous
-        prev = self.previous
-        self.slopes = {s: (values[s[0]][s[1]] - prev[s]) / dt for s in self.signals}
+        """The extrapolation for the step from t (values: those read at t)."""
+        coefficients = {}
+        for s, hist in self.history.items():
+            v = values[s[0]][s[1]]
+            if not hist or hist[-1][0] >= t:
+                slope = self.carried.get(s)
+                if slope is not None:
+                    coefficients[s] = (slope, 0.0, 0.0)
+                continue
+            t1, v1 = hist[-1]
+            d1 = (v - v1) / (t - t1)
+            d2 = 0.0
+            if len(hist) > 1:
+                t0, v0 = hist[-2]
+                d2 = (d1 - (v1 - v0) / (t1 - t0)) / (t - t0)
+            coefficients[s] = (d1, d2, t - t1)
+        self.coefficients = coefficients
+        self.carried = {}
 
     def accepted(self, t: float, values: list[list[float]]) -> None:
-        """The step from t was accepted without a switch: t is the previous point now."""
-        self.t_previous = t
-        self.previous = {s: values[s[0]][s[1]] for s in self.signals}
+        """The step from t was accepted without a switch: t is the last point now."""
+        for s, hist in self.history.items():
+            hist.append((t, values[s[0]][s[1]]))
+            del hist[: -self.points]
+
+    def switched(self, internal: bool) -> None:
+        """The step ended on a switch.  At a regime change every signal starts anew.  At
+        an FMU's internal event (a friction sign, a mesh piece) the signals go on at the
+        slopes they had: a jump there would spoil a slope through it, and a kink (the
+        others' rates change with the event) would spoil one kept across it (measured:
+        keeping the points of the signals that did not jump doubled M739's error)."""
+        for s, hist in self.history.items():
+            hist.clear()
+            c = self.coefficients.get(s)
+            if internal and c is not None:
+                self.carried[s] = c[0]
 
     def mean(self, source: tuple[int, int], start: float, h: float) -> float:
         """Mean over [t, t+h] of the extrapolated signal."""
-        return start + 0.5 * h * self.slopes.get(source, 0.0)
+        c = self.coefficients.get(source)
+        if c is None:
+            return start
+        return start + c[0] * 0.5 * h + c[1] * (h * h / 3.0 + 0.5 * c[2] * h)
 
     @property
     def second_order(self) -> bool:
-        return bool(self.slopes)
+        return bool(self.coefficients)
 
 
 class SinglePassMaster(RegimeAwareMaster):
@@ -101,6 +128,15 @@ class SinglePassMaster(RegimeAwareMaster):
             inst.setter(inst.refs([EARLY_RETURN_INPUT]), integer=True)([1])
             self.early.append(i)
             self.reached_slot[i] = system.real_output_slot(i, REACHED_OUTPUT)
+        # Step means: an output named after a connected one with "_mean" is its mean over
+        # the last step, what a receiver stepped after it should hold.
+        self.means: dict[tuple[int, int], int] = {}
+        for c, src in zip(system.connections, system.connection_sources, strict=True):
+            mean = c.source[1] + MEAN_SUFFIX
+            if src is not None and mean in system.models[src[0]].variables:
+                self.means[src] = system.real_output_slot(src[0], mean)
+        givers = {s for s, _ in self.means}
+        self.early.sort(key=lambda i: i not in givers)
         self.late = [i for i in range(len(self.names)) if i not in self.early]
         # Sampled inputs whose receiver reports its own copy at the step end (an output
         # named after the input with "_own"): (source, receiver's copy).  The copy
@@ -130,56 +166,66 @@ class SinglePassMaster(RegimeAwareMaster):
         self.returned: set[int] = set()  # FMUs that ended the last pass at their own event
         self.end_values: list[list[float]] = []
         self.rate: dict[tuple[int, int], float] = {}  # largest rate of a copied source
+        self.last_step: dict[tuple[int | None, ...], float] = {}
+        self.h_tried = 0.0  # the step the last pass was asked to take
 
     # -- one pass -----------------------------------------------------------------------
-    def feeds_for(self, h: float, before: _Snapshot) -> list[list[float]]:
-        start = before.values
-        ex = self.extrapolation
-        return [
-            [
-                ex.mean((s, k), start[s][k], h) if averaged else start[s][k]
-                for (s, k), averaged in inputs
-            ]
-            for inputs in self.held_inputs
-        ]
+    def feeds_for(
+        self, h: float, before: _Snapshot, done: set[int] = frozenset()
+    ) -> list[list[float]]:
+        """Every FMU's Real inputs for a step h from the snapshot: held signals at the mean
+        of their extrapolation, sampled ones at their start values, and from a source
+        already stepped over this very step (``done``) that gives its step mean, that."""
+        start, now = before.values, self.system.values
+        ex, means = self.extrapolation, self.means
+        feeds = []
+        for inputs in self.held_inputs:
+            row = []
+            for (s, k), averaged in inputs:
+                mean = means.get((s, k)) if s in done else None
+                if mean is not None:
+                    row.append(now[s][mean])
+                elif averaged:
+                    row.append(ex.mean((s, k), start[s][k], h))
+                else:
+                    row.append(start[s][k])
+            feeds.append(row)
+        return feeds
 
     def one_pass(self, t: float, h: float, before: _Snapshot, state: list[Any]) -> float:
-        """Step every FMU once from t: those that end at their first event first, each to
-        where the earliest so far stopped, then the others there.  An FMU stepped past an
-        event another one stopped at before it is stepped again to it (in scene order:
-        the cheaper first).  Returns the step taken."""
+        """Step every FMU once from t, those that end at their first event first (the
+        ones that give step means before their receivers), each to where the earliest so
+        far stopped, then the others there.  When one stops before an instant the ones
+        before it were stepped to, those are stepped again from t to it.  Returns the
+        step taken."""
         system = self.system
-        feeds = self.feeds_for(h, before)
-        for i in range(len(feeds)):
-            system.feed(i, feeds[i], before.ints)
         h_end = h
         returned = self.returned = set()
-        stepped: dict[int, float] = {}  # early FMU -> the step it took
-        pending = list(self.early)
-        while pending:
-            i = pending.pop(0)
-            if i in stepped:  # past the event another stopped at: back to t, once more
-                system.instances[i].set_state(state[i])
-                system.feed(i, self.feeds_for(h_end, before)[i], before.ints)
-                self.stats.rollbacks += 1
-            system.step(i, t, h_end)
-            self.stats.do_steps += 1
-            stepped[i] = h_end
-            system.read(i)
-            reached = system.values[i][self.reached_slot[i]]
-            if t < reached < t + h_end:
-                h_end = reached - t
-                returned.clear()
-                returned.add(i)
-                pending.extend(j for j in stepped if j != i and j not in pending)
-            else:
-                returned.discard(i)
-        if h_end < h:
-            # Held inputs over the shorter step: the means of the extrapolation over it.
-            feeds = self.feeds_for(h_end, before)
-            for i in self.late:
-                system.feed(i, feeds[i], before.ints)
+        for round_ in range(MAX_ROUNDS):
+            done: set[int] = set()
+            again = False
+            for i in self.early:
+                if round_ > 0:
+                    system.instances[i].set_state(state[i])
+                    self.stats.rollbacks += 1
+                system.feed(i, self.feeds_for(h_end, before, done)[i], before.ints)
+                system.step(i, t, h_end)
+                self.stats.do_steps += 1
+                system.read(i)
+                done.add(i)
+                reached = system.values[i][self.reached_slot[i]]
+                if t < reached < t + h_end:
+                    again = bool(done - {i})  # those before it went past its event
+                    h_end = reached - t
+                    returned.clear()
+                    returned.add(i)
+                else:
+                    returned.discard(i)
+            if not again:
+                break
+        feeds = self.feeds_for(h_end, before, done)
         for i in self.late:
+            system.feed(i, feeds[i], before.ints)
             system.step(i, t, h_end)
         self.stats.do_steps += len(self.late)
         system.read_all()
@@ -248,7 +294,7 @@ class SinglePassMaster(RegimeAwareMaster):
                 self.extrapolation.accepted(t - h, before.values)
                 stats.events += self.log_switches(t - h, before)
                 recorder.row(system.record_row(t))
-                h = min(cfg.max_step, h * control.grow(ratio, self.first_order))
+                h = min(cfg.max_step, h * self._grow(ratio))
                 self._remember_step(tuple(before.regimes), ratio, h)
                 same_instant = 0
             else:
@@ -261,10 +307,7 @@ class SinglePassMaster(RegimeAwareMaster):
                 else:
                     stats.events += max(switches, 1)
                 recorder.row(system.record_row(t))
-                if self.internal:
-                    self.extrapolation.carry()
-                else:
-                    self.extrapolation.reset()
+                self.extrapolation.switched(self.internal)
                 window = self.instant
                 same_instant = same_instant + 1 if h <= window else 0
                 if same_instant > cfg.max_events_per_step:
@@ -273,12 +316,37 @@ class SinglePassMaster(RegimeAwareMaster):
                         f"{window:.1e} s of each other; last in {self._last_switch()}",
                         t,
                     )
-                h = self._restart_step(tuple(system.regimes()))
+                if self.internal:
+                    h = min(cfg.max_step, self.h_tried)  # the rates go on: so does the step
+                else:
+                    h = self._restart_step(tuple(system.regimes()))
             progress(t)
             stop_indicator = system.stop_indicator()
             if stop_indicator is not None and stop_indicator <= 0.0:
                 stats.extra["stopped_by_condition"] = True
                 return
+
+    def _shrink(self, ratio: float) -> float:
+        c = self.control
+        if self.first_order:
+            return c.shrink(ratio, True)
+        return max(c.max_shrink, (c.safety_second_order / ratio) ** EXPONENT)
+
+    def _grow(self, ratio: float) -> float:
+        c = self.control
+        if ratio == 0.0:
+            return c.max_growth
+        return min(c.max_growth, self._shrink(ratio))
+
+    def _remember_step(self, regimes: tuple[int | None, ...], ratio: float, h: float) -> None:
+        """The step proposed last in these regimes (the restart after a switch into them)."""
+        self.last_step[regimes] = h
+
+    def _restart_step(self, regimes: tuple[int | None, ...]) -> float:
+        """After a switch: a fraction of the step proposed last in the regimes entered (a
+        too long one costs one pass), at least master.step."""
+        remembered = self.last_step.get(regimes, 0.0) * RESTART
+        return max(self.cfg.first_step, remembered)
 
     def _attempt(
         self, t: float, h: float, before: _Snapshot, state: list[Any]
@@ -288,7 +356,7 @@ class SinglePassMaster(RegimeAwareMaster):
         last_ratio = None
         stalled = 0
         for _ in range(control.max_trials):
-            h_full = h
+            h_full = self.h_tried = h
             h = self.one_pass(t, h, before, state)
             early = h < h_full
             te = self.switch_time(t, h, before)
@@ -301,7 +369,7 @@ class SinglePassMaster(RegimeAwareMaster):
                 if t + h - te <= self._landing_window() or h <= cfg.min_step:
                     if ratio > 1.0 and h > cfg.min_step:
                         # The step onto the switch must pass the error test as well.
-                        h = max(cfg.min_step, h * control.shrink(ratio, self.first_order))
+                        h = max(cfg.min_step, h * self._shrink(ratio))
                         self._rollback(state, before)
                         last_ratio = None
                         continue
@@ -317,7 +385,7 @@ class SinglePassMaster(RegimeAwareMaster):
                     self.stats.extra["jumps"] = self.stats.extra.get("jumps", 0) + 1
                     return h, t + h, ratio
                 last_ratio = ratio
-                h = max(cfg.min_step, h * control.shrink(ratio, self.first_order))
+                h = max(cfg.min_step, h * self._shrink(ratio))
                 self._rollback(state, before)
                 continue
             return h, None, ratio
