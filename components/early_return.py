@@ -32,10 +32,12 @@ EARLY_RETURN_VARIABLES = (
 class UntilFirstEvent:
     """A model as :func:`components.event_integration.advance` sees it when the step is to
     end at its first event after the start: the integration halts there.  An event at the
-    very start (the inputs crossed an indicator) does not end the step."""
+    very start (the inputs crossed an indicator), or closer to it than the resolution of
+    the start time, does not end the step."""
 
-    def __init__(self, model: Any) -> None:
+    def __init__(self, model: Any, start: float = 0.0) -> None:
         self.model = model
+        self.start = start  # the step's start time: an event must move it to end there
         self.deriv = model.deriv
         self.indicators = model.indicators
         self.accept = getattr(model, "accept", None)
@@ -47,7 +49,7 @@ class UntilFirstEvent:
 
     def event(self, y: list[float], index: int, t: float) -> list[float]:
         y = self.model.event(y, index, t)
-        if t > 0.0:
+        if self.start + t > self.start:  # not at the start (nor below its resolution)
             self.stopped_at = t
         return y
 

@@ -136,7 +136,7 @@ class TrainComponent(Component):
             return
         # Early return (components.early_return): end at the first event (a mesh piece, a
         # branch, a reversal: each jumps the response the escapement takes).
-        model = UntilFirstEvent(m) if self.early_return else m
+        model = UntilFirstEvent(m, t) if self.early_return else m
         done = advance(model, self._y, h, self._control, self._h_next)
         self.t_reached = reached(t, h, model)
         self._y, self._h_next = done.y, done.h_next

@@ -1022,7 +1022,7 @@ class VergeEscapement(Component):
             self._outputs(y)
             self.T_esc_mean = self.T_esc_static_mean = self.T_esc
             return
-        model = UntilFirstEvent(core) if self.early_return else core
+        model = UntilFirstEvent(core, t) if self.early_return else core
         w0, impacts, coupled = y[1], core.impacts, core.coupled
         done = advance(model, y, h, self._control, self._h_next)
         y, self._h_next = done.y, done.h_next
@@ -1035,7 +1035,8 @@ class VergeEscapement(Component):
         # J_ref (w1 - w0) = (T_ref + c_load T_esc_mean) dt, w1 just before an impact.
         w1 = core.last_impact[0] if core.impacts != impacts else y[1]
         held = self._held
-        dt = self.t_reached - t
+        stopped = getattr(model, "stopped_at", -1.0)
+        dt = stopped if stopped > 0.0 else h  # the step's length (not a rounded difference)
         if coupled or core.coupled or core.impacts != impacts:
             mean = (held.j_ref * (w1 - w0) / dt - held.t_ref) / held.c_load
         else:

@@ -304,7 +304,7 @@ class SinglePassMaster(RegimeAwareMaster):
                 self.extrapolation.accepted(t - h, before.values)
                 stats.events += self.log_switches(t - h, before)
                 recorder.row(system.record_row(t))
-                h = min(cfg.max_step, h * self._grow(ratio))
+                h = min(cfg.max_step, max(cfg.min_step, h * self._grow(ratio)))
                 self._remember_step(tuple(before.regimes), ratio, h)
                 same_instant = 0
             else:
@@ -329,7 +329,8 @@ class SinglePassMaster(RegimeAwareMaster):
                         t,
                     )
                 if self.internal:
-                    h = min(cfg.max_step, self.h_tried)  # the rates go on: so does the step
+                    # The rates go on: so does the step.
+                    h = min(cfg.max_step, max(cfg.min_step, self.h_tried))
                 else:
                     h = self._restart_step(tuple(system.regimes()))
             progress(t)
