@@ -1,20 +1,31 @@
 """The regime-aware master with one pass per macro step (``input_hold = "extrapolated"``).
 
-Each FMU is stepped once per macro step.  A held input is set to the mean over the step of
-its source's linear extrapolation from the last two exchange points (the inputs of one
-regime: after a switch the history restarts and the first step holds the values at its
-start).  After the step, the extrapolation is compared with what the sources actually did:
-the error estimate is the difference between the mean that was used and the trapezoidal
-mean of the actual start and end values, relative to each signal's running scale, as in
-Schierz, Arnold & Clauß, "Co-simulation with communication step size control in an FMI
-compatible master algorithm", 9th International Modelica Conference (2012).  A step is
-retaken only when that estimate exceeds the tolerance.
+Each FMU is stepped once per macro step; a step is retaken only when its error estimate
+exceeds the tolerance.
 
-Switches: an FMU that can end its step at its own first event (an Integer input
-``early_return``; it says how far it got in ``t_reached``) is stepped first with it set;
-the others are then stepped once, to that instant.  A switch that only an indicator or a
-reported event time of another FMU shows is located and landed on as in the midpoint
-master (rollback and a shorter pass).
+Inputs.  A held input is set to the mean over the step of its source's linear
+extrapolation from the last exchange point of the same regime (after a regime switch the
+first step holds the start values; over an FMU's internal event the slopes go on).  A
+source stepped earlier in the same pass that gives its step mean (an output named after
+the connected one with ``_mean``: the verge's escapement torque whose impulse its wheel
+took) gives that instead, so its receiver takes the very impulse of the step.
+
+Error.  Where a receiver reports its own copy of a sampled input (an output named after
+the input with ``_own``: the verge's copy of the escape wheel), the estimate is the copy's
+mismatch with the source at the step end, per unit step (against the source's travel in
+the step at its largest rate so far): it measures the held inputs' effect on the motion.
+Elsewhere it is each held signal's extrapolated mean against the trapezoidal mean of its
+actual start and end values, relative to its running scale, as in Schierz, Arnold &
+Clauß, "Co-simulation with communication step size control in an FMI compatible master
+algorithm", 9th International Modelica Conference (2012).
+
+Switches.  An FMU with an Integer input ``early_return`` (``components.early_return``)
+ends its step at its first event and says where in ``t_reached``; such FMUs are stepped
+first (those giving step means before their receivers), each to where the earliest so far
+stopped, and the others once to that instant: landing on a switch costs one doStep of
+each FMU, none retaken.  When one stops before an instant the ones before it were stepped
+to, all are stepped again to it.  A switch that only an indicator or a reported event
+time of another FMU shows is located and landed on as in the midpoint master.
 """
 
 from __future__ import annotations
