@@ -300,6 +300,9 @@ def _first_within(scene_file: str, quantity: str, truth: float | None, budget: f
             show_progress=False,
             compare_reference=truth is None,
         )
+        if result.status != "completed":
+            print(f"  single pass at {tol:g}: {result.status}: {result.message}")
+            continue
         if truth is None:
             err = result.accuracy["trajectory_error"]
         else:
