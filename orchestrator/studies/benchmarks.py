@@ -301,7 +301,7 @@ def _first_within(scene_file: str, quantity: str, truth: float | None, budget: f
             compare_reference=truth is None,
         )
         if result.status != "completed":
-            print(f"  single pass at {tol:g}: {result.status}: {result.message}")
+            print(f"  single pass at {tol:g}: {result.status}: {result.message.splitlines()[0]}")
             continue
         if truth is None:
             err = result.accuracy["trajectory_error"]
