@@ -247,7 +247,8 @@ class SinglePassMaster(RegimeAwareMaster):
             system.feed(i, feeds[i], before.ints)
             system.step(i, t, h_end)
         self.stats.do_steps += len(self.late)
-        system.read_all()
+        for i in self.late:  # the early ones were read after their step
+            system.read(i)
         # The values at the step end with the inputs of the step (an impact not yet taken):
         # what the error estimate compares the extrapolation with.
         self.end_values = list(system.values)  # read() replaces the inner lists
