@@ -518,6 +518,7 @@ def run_regime_aware(
         return
     settings = scene.master.settings
     if settings.single_pass:
+        # Imported here: the single-pass master builds on this module's master.
         from orchestrator.masters.single_pass import SinglePassMaster
 
         master: RegimeAwareMaster = SinglePassMaster(
