@@ -8,6 +8,7 @@ when its inertia rides on the wheel, and applies impacts as a new wheel speed.
 from __future__ import annotations
 
 from .base import Variable
+from .early_return import EARLY_RETURN_VARIABLES
 
 #: The escape-wheel port of a spin-driven train, and of the verge on the other side: the
 #: train sends the wheel state and its affine response, the verge the escapement moment
@@ -109,4 +110,5 @@ ESCAPE_WHEEL_VARIABLES = (
     ),
     Variable("c_load", "output", "1", 1.0, "factor of T_esc in J_ref phi_dd = T_ref + c T_esc"),
     Variable("J_stot", "output", "kg.m2", 0.0, "frictionless reflected inertia (impacts, B213)"),
+    *EARLY_RETURN_VARIABLES,
 )

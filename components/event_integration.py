@@ -300,6 +300,14 @@ def _first_step(y: list[float], k1: list[float], control: StepControl) -> float:
     return 0.01 * d0 / d1
 
 
+def _model_halted(model: EventModel) -> bool:
+    """Whether the model has halted.  A wrapper that only ends the step at an event
+    (``components.early_return.UntilFirstEvent``) says apart whether the model itself did
+    (``model_halted``): the events of that instant still all fire."""
+    own = getattr(model, "model_halted", None)
+    return own if own is not None else getattr(model, "halted", False)
+
+
 def _fire_at_instant(
     model: EventModel, y: list[float], first: int, t: float, g_start: Sequence[float]
 ) -> tuple[list[float], int]:
@@ -314,7 +322,7 @@ def _fire_at_instant(
     """
     y = model.event(y, first, t)
     fired = {first}
-    while not getattr(model, "halted", False):
+    while not _model_halted(model):
         g = model.indicators(y)
         nxt = next(
             (

@@ -8,6 +8,7 @@ from __future__ import annotations
 from typing import Any
 
 from .base import Component, SnapshotPlan
+from .early_return import UntilFirstEvent, reached
 from .event_integration import advance, step_control
 
 #: Magnitudes below which the integration controls the state [phi, phi_d, W] absolutely:
@@ -128,11 +129,16 @@ class TrainComponent(Component):
         self._apply_inputs()
         m = self._model
         m.t_first_event = -1.0
+        self.t_reached = t + h
         if m.stuck and self._y[1] == 0.0:
             # Held at rest by static friction under held inputs: nothing moves in this step.
             self._outputs()
             return
-        done = advance(m, self._y, h, self._control, self._h_next)
+        # Early return (components.early_return): end at the first event (a mesh piece, a
+        # branch, a reversal: each jumps the response the escapement takes).
+        model = UntilFirstEvent(m, t) if self.early_return else m
+        done = advance(model, self._y, h, self._control, self._h_next)
+        self.t_reached = reached(t, h, model)
         self._y, self._h_next = done.y, done.h_next
         if m.t_first_event >= 0.0:
             self.t_event = t + m.t_first_event

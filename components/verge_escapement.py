@@ -55,6 +55,7 @@ from collections.abc import Callable
 from typing import Any
 
 from .base import Component, ComponentError, SnapshotPlan, Variable, common_outputs
+from .early_return import EARLY_RETURN_VARIABLES, UntilFirstEvent, reached
 from .escape_wheel import ESCAPE_WHEEL_PORT
 from .event_integration import INTEGRATION_VARIABLES, advance, step_control
 from .m739_data import M739, M739Data
@@ -761,6 +762,10 @@ class VergeEscapement(Component):
     fired at the step start): keep the step, giving an impact to the train first.
     Energy: stored = 1/2 I_p psi_dot^2; the impact losses are booked here.
 
+    Early return (``components.early_return``): with the input ``early_return`` = 1 a step
+    ends just after its first event (regime change, impact, friction sign or branch: each
+    jumps T_esc or the impact outputs) and ``t_reached`` says where.
+
     Port ``escape_wheel``: angle and speed (in), torque T_esc (out), and the train's
     affine response (inertia J_ref, drive T_ref, load_factor c_load, impact_inertia J_stot).
     The other way the escapement is an affine load: T_esc = T_esc_static - J_esc phi_ddot
@@ -893,6 +898,12 @@ class VergeEscapement(Component):
             "escapement inertia felt at the wheel (coupled)",
             depends_on=_WHEEL_STATE,
         ),
+        # Over the last step, for a train stepped after the verge over the same interval:
+        # the escapement as the plain torque whose impulse the verge's wheel took (impacts
+        # aside: they reach the train as phi_dot_post), exact with early return.
+        Variable("T_esc_mean", "output", "N.m", 0.0, "T_esc over the last step, mean"),
+        Variable("T_esc_static_mean", "output", "N.m", 0.0, "= T_esc_mean (with J_esc_mean = 0)"),
+        Variable("J_esc_mean", "output", "kg.m2", 0.0, "0: the step mean is a plain torque"),
         Variable(
             "phi_ddot",
             "output",
@@ -900,6 +911,14 @@ class VergeEscapement(Component):
             0.0,
             "escape-wheel acceleration (own)",
             depends_on=_WHEEL_AND_TRAIN,
+        ),
+        Variable(
+            "phi_own",
+            "output",
+            "rad",
+            0.0,
+            "escape-wheel angle (own copy)",
+            depends_on=("phi",),
         ),
         Variable(
             "phi_dot_own",
@@ -960,6 +979,7 @@ class VergeEscapement(Component):
             -1.0,
             "first regime change or impact of the last step that had one",
         ),
+        *EARLY_RETURN_VARIABLES,
         Variable(
             "J_load",
             "output",
@@ -988,6 +1008,7 @@ class VergeEscapement(Component):
         self._g_end = self._core.indicators(self._y)
         self._cos0 = math.cos(k.gamma_pp - self._y[2] - self._core.psic)
         self.t_event = -1.0
+        self.t_reached = t0
         self._outputs(self._y)
 
     def _take_inputs(self) -> list[float]:
@@ -1011,6 +1032,7 @@ class VergeEscapement(Component):
 
     def step(self, t: float, h: float) -> None:
         core = self._core
+        self.t_reached = t + h
         y = self._take_inputs()
         core.t_base = t
         core.t_mark = -1.0
@@ -1024,10 +1046,13 @@ class VergeEscapement(Component):
             self._y = y
             self._g_end = core.indicators(y)
             self._outputs(y)
+            self.T_esc_mean = self.T_esc_static_mean = self.T_esc
             return
         core.budget = int(self.max_internal_steps)
+        model = UntilFirstEvent(core, t) if self.early_return else core
+        w0, impacts, coupled = y[1], core.impacts, core.coupled
         try:
-            done = advance(core, y, h, self._control, self._h_next)
+            done = advance(model, y, h, self._control, self._h_next)
         except StepBudgetSpent:
             raise ComponentError(
                 f"VergeEscapement: doStep from t = {t:.9g} s over {h:.6g} s spent its budget of "
@@ -1041,9 +1066,21 @@ class VergeEscapement(Component):
             raise ComponentError(f"VergeEscapement: {core.fault}")
         if core.t_mark >= 0.0:
             self.t_event = t + core.t_mark
+        self.t_reached = reached(t, h, model)
+        # The mean escapement torque on the wheel over the step, from the held response:
+        # J_ref (w1 - w0) = (T_ref + c_load T_esc_mean) dt, w1 just before an impact.
+        w1 = core.last_impact[0] if core.impacts != impacts else y[1]
+        held = self._held
+        stopped = getattr(model, "stopped_at", -1.0)
+        dt = stopped if stopped > 0.0 else h  # the step's length (not a rounded difference)
+        if coupled or core.coupled or core.impacts != impacts:
+            mean = (held.j_ref * (w1 - w0) / dt - held.t_ref) / held.c_load
+        else:
+            mean = 0.0  # free throughout (an early return ends at the first contact)
         self._y = y
         self._g_end = core.indicators(y)
         self._outputs(y)
+        self.T_esc_mean = self.T_esc_static_mean = mean
 
     def _resync_events(self, y: list[float]) -> list[float]:
         """Fire the events that the jump to the input state crossed (e.g. the tooth is
@@ -1079,7 +1116,7 @@ class VergeEscapement(Component):
             self.ind_face_end, self.ind_gap = ind[IND_FACE_END], ind[IND_CONTACT]
         self.v_close = core.closing_speed(y)[0]
         self.phi_ddot = acc
-        self.phi_dot_own = y[1]
+        self.phi_own, self.phi_dot_own = y[0], y[1]
         self.psi_local = psi
         self.psi_dot = psi_d
         body = psi + core.psic - k.d.psic

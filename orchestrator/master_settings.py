@@ -108,13 +108,18 @@ class RegimeAwareSettings:
     max_step: float = setting(None, "s")  # default: 100 first steps, at most the run
     max_iterations: int = setting(10)  # exchange rounds at a switching instant
     max_events_per_step: int = setting(50)  # switches at (nearly) one instant: chattering
-    input_hold: str = setting("midpoint", choices=("start", "midpoint"))
+    input_hold: str = setting("midpoint", choices=("start", "midpoint", "extrapolated"))
     control: StepControl = StepControl()
 
     @property
     def midpoint(self) -> bool:
         """Corrector with held inputs at their step mean (else held at the step start)."""
         return self.input_hold == "midpoint"
+
+    @property
+    def single_pass(self) -> bool:
+        """One pass per macro step with extrapolated inputs (masters/single_pass.py)."""
+        return self.input_hold == "extrapolated"
 
     @classmethod
     def from_options(cls, step: float, duration: float, options: dict[str, Any]):

@@ -140,6 +140,17 @@ class CoupledSystem:
             t_event=self._slot(i, model.event_time)[1] if model.event_time else None,
         )
 
+    def real_output_slot(self, i: int, var: str) -> int:
+        """Slot of instance i's Real output ``var`` in its read values, read from now on."""
+        kind, slot = self._slot(i, var)
+        if kind != "real":
+            raise RunError(f"{self.names[i]}.{var} is not a Real variable")
+        inst = self.instances[i]
+        self.real_refs[i] = inst.refs(self.real_names[i])
+        self._get_reals[i] = inst.getter(self.real_refs[i])
+        self.read(i)
+        return slot
+
     # -- life cycle -------------------------------------------------------------------
     def initialize(self) -> None:
         scene = self.scene

@@ -10,7 +10,7 @@ from __future__ import annotations
 from orchestrator.master_settings import TOLERANCE_MASTERS
 from orchestrator.masters.fixed_step import gauss_seidel, jacobi
 from orchestrator.masters.macro_step import MacroStep, Master, MasterFactory
-from orchestrator.masters.regime_aware import regime_aware
+from orchestrator.masters.regime_aware_choice import regime_aware
 
 MASTERS: dict[str, MasterFactory] = {
     "jacobi": jacobi,

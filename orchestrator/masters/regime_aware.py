@@ -39,11 +39,9 @@ from typing import Any, NamedTuple
 
 from orchestrator.errors import RunError
 from orchestrator.master_settings import RegimeAwareSettings
-from orchestrator.masters.fixed_step import fixed_step_master
-from orchestrator.masters.macro_step import MacroStep, Master
+from orchestrator.masters.macro_step import MacroStep
 from orchestrator.observers import regime_changes
 from orchestrator.recorder import StepStats
-from orchestrator.scenario import Scene
 from orchestrator.system import CoupledSystem
 
 
@@ -553,21 +551,3 @@ def _same(a: list[float], b: list[float]) -> bool:
     return all(
         x == y and math.copysign(1.0, x) == math.copysign(1.0, y) for x, y in zip(a, b, strict=True)
     )
-
-
-def regime_aware(system: CoupledSystem, scene: Scene, stats: StepStats) -> Master:
-    """The regime-aware master of ``scene``; fixed-step Jacobi where an FMU cannot save and
-    restore its state."""
-    blind = [n for n, m in zip(system.names, system.models, strict=True) if not m.can_get_set_state]
-    if blind:
-        # Without rollback no trial can be taken back: say what is given up, and couple
-        # the way every tool can.
-        stats.extra.setdefault("warnings", []).append(
-            f"FMU {', '.join(map(repr, blind))} cannot save and restore its state "
-            "(canGetAndSetFMUstate is false), which the regime-aware master needs to reject "
-            "steps and to land on switches: it gives both up and runs fixed-step Jacobi at "
-            f"master.step = {scene.master.step:g} s (no error control, switches seen only "
-            "at communication points)"
-        )
-        return fixed_step_master(system, scene, stats, scene.master.step, sequential=False)
-    return RegimeAwareMaster(system, scene.master.settings, stats)

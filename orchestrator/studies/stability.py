@@ -54,14 +54,17 @@ def run_suite(
     dask_address: str | None = None,
     masters: tuple[str, ...] = STABILITY_MASTERS,
     cases: tuple[str, ...] | None = None,
+    overrides: dict[str, object] | None = None,
 ) -> list[CaseRow]:
-    """Run every case (or those named in ``cases``) under each master; write the table."""
+    """Run every case (or those named in ``cases``) under each master, with ``overrides``
+    of every case's settings (e.g. the regime-aware master's ``master.input_hold``); write
+    the table."""
     out_dir.mkdir(parents=True, exist_ok=True)
     files = [f for f in case_files(suite_dir) if cases is None or f.stem in cases]
     jobs = [
         Job(
             str(f),
-            {"master.algorithm": m},
+            {"master.algorithm": m, **(overrides or {})},
             str(out_dir / f.stem / m),
             f"{f.stem}|{m}",
             compare_reference=False,

@@ -183,3 +183,16 @@ def test_an_indicator_negative_before_the_step_does_not_fire() -> None:
     model.stop_at = -1.0  # behind the wheel from the start: never armed
     advance(model, [0.0], 3.5, StepControl(1e-8, (1.0,)), tol_t=1e-13)
     assert [i for i, _ in model.fired] == [0, 0, 0]
+
+
+def test_an_early_return_still_fires_every_event_of_its_instant() -> None:
+    """A step that ends at its first event (early return) ends after the instant's other
+    events, not between them: the next step would start with them below zero."""
+    from components.early_return import UntilFirstEvent
+
+    model = TwoClocks()
+    wrapper = UntilFirstEvent(model, 0.0)
+    done = advance(wrapper, [0.0], 3.0, StepControl(1e-8, (1.0,)), tol_t=1e-13)
+    assert [i for i, _ in model.fired] == [0, 1]  # both of t = 1, not the one at t = 2
+    assert done.y[0] == pytest.approx(1.0, abs=1e-12)
+    assert wrapper.stopped_at == pytest.approx(1.0, abs=1e-12)

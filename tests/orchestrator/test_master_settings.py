@@ -28,7 +28,7 @@ def test_every_master_has_settings_and_every_key_is_a_field() -> None:
     assert TOLERANCE_MASTERS == ("regime-aware",)
     fields = {f.name for cls in SETTINGS.values() for f in dataclasses.fields(cls)}
     assert set(SETTING_KINDS) <= fields
-    assert SETTING_KINDS["input_hold"].choices == ("start", "midpoint")
+    assert SETTING_KINDS["input_hold"].choices == ("start", "midpoint", "extrapolated")
     assert SETTING_KINDS["max_iterations"].is_count
     assert SETTING_KINDS["event_tolerance"].unit == "s"
 
