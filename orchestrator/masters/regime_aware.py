@@ -365,16 +365,7 @@ class RegimeAwareMaster:
             return MacroStep(end, h, changes_at=t, regimes_before=before.regimes)
         stats.iterations += self.settle() - 1
         self._note_changes(before)
-        failure = None
-        window = self.instant
-        self.same_instant = self.same_instant + 1 if h <= window else 0
-        if self.same_instant > cfg.max_events_per_step:
-            failure = RunError(
-                f"chattering: {self.same_instant} switches within "
-                f"{window:.1e} s of each other; "
-                f"last in {self._last_switch()}",
-                end,
-            )
+        failure = self._chattering(h, end)
         self.h = self._restart_step(tuple(system.regimes()))
         return MacroStep(
             end,
@@ -383,6 +374,19 @@ class RegimeAwareMaster:
             regimes_before=before.regimes,
             left_row=left,  # values just before the switch
             failure=failure,
+        )
+
+    def _chattering(self, h: float, end: float) -> RunError | None:
+        """After a step of h onto a switch: the error that ends a run switching again and
+        again within one instant (Zeno / chattering guard), else None."""
+        window = self.instant
+        self.same_instant = self.same_instant + 1 if h <= window else 0
+        if self.same_instant <= self.cfg.max_events_per_step:
+            return None
+        return RunError(
+            f"chattering: {self.same_instant} switches within {window:.1e} s of each other; "
+            f"last in {self._last_switch()}",
+            end,
         )
 
     def _remember_step(self, regimes: tuple[int | None, ...], ratio: float, h: float) -> None:

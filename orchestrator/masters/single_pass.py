@@ -329,15 +329,7 @@ class SinglePassMaster(RegimeAwareMaster):
         if internal_only:
             stats.extra["internal_events"] = stats.extra.get("internal_events", 0) + 1
         self.extrapolation.switched(self.internal)
-        failure = None
-        window = self.instant
-        self.same_instant = self.same_instant + 1 if h <= window else 0
-        if self.same_instant > cfg.max_events_per_step:
-            failure = RunError(
-                f"chattering: {self.same_instant} switches within "
-                f"{window:.1e} s of each other; last in {self._last_switch()}",
-                end,
-            )
+        failure = self._chattering(h, end)
         if self.internal:
             # The rates go on: so does the step.
             self.h = min(cfg.max_step, max(cfg.min_step, self.h_tried))

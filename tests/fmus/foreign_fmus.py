@@ -50,9 +50,7 @@ from __future__ import annotations
 
 import copy
 import math
-import os
 import platform
-import shutil
 import subprocess
 import sys
 import tempfile
@@ -77,6 +75,8 @@ from fmpy.model_description import (
     Unit,
     Unknown,
 )
+
+from fmus.host_loader import c_compiler  # the same compiler the FMU build uses
 
 FOREIGN_DIR = Path(__file__).resolve().parent / "foreign"
 TORSION_BODY_SOURCE = FOREIGN_DIR / "torsion_body.c"
@@ -131,16 +131,6 @@ DEFAULT_EXPERIMENT = {"startTime": "0.0", "stopTime": "0.1", "stepSize": "1e-3"}
 
 class ForeignFmuError(RuntimeError):
     """A foreign test FMU cannot be built here (no compiler, unsupported platform)."""
-
-
-def c_compiler() -> str | None:
-    """Path of a C compiler ($CC if it resolves, else cc or gcc on PATH), or None."""
-    for name in (os.environ.get("CC"), "cc", "gcc"):
-        if name:
-            found = shutil.which(name)
-            if found:
-                return found
-    return None
 
 
 def fmi2_platform() -> tuple[str, str]:
