@@ -317,3 +317,18 @@ def test_every_scene_converges(name, fmu_cache, tmp_path):
     rows = _errors(name, ["0.4 ms", "0.2 ms", "0.1 ms", "0.05 ms"], None, fmu_cache, tmp_path)
     for key in ("windup", "energy"):
         _assert_first_order(rows, key)
+
+
+def test_a_reference_too_stiff_for_its_integrator_gives_up_with_a_reason() -> None:
+    """A load inertia of 1e-9 kg.m2 makes the explicit reference crawl (it ran for more than
+    17 minutes in a fuzzed run): it stops at its evaluation budget and says why, which the
+    run turns into a note instead of hanging."""
+    from dataclasses import replace
+
+    from orchestrator.scenes.press_feed.monolithic import simulate_feed
+    from orchestrator.scenes.press_feed.report import feed_options
+
+    scene = load_scene(SCENARIOS / "press_feed_run1.toml", {"fmus.load.parameters.j": 1e-9})
+    options = replace(feed_options(scene), max_evaluations=20_000)
+    with pytest.raises(RuntimeError, match=r"20000 evaluations spent by t = .* too stiff"):
+        simulate_feed(options)

@@ -114,6 +114,10 @@ class FeedOptions:
     atol: float = 1e-14
     max_step: float = 2.0e-3
     samples_per_cycle: int = 1440
+    # Right-hand-side evaluations the explicit reference may spend: the example runs need
+    # 6,000-20,000 for three cycles; a very stiff variant (say a load inertia of 1e-9
+    # kg.m2) would otherwise grind on for hours.
+    max_evaluations: int = 2_000_000
 
 
 @dataclass
@@ -386,6 +390,10 @@ def _setup(o: FeedOptions):
     return _Nonlinear(drive, k, c_lin, c_nl, t_b, j5, phi1_0), np.zeros(NY), rpm
 
 
+class _BudgetSpent(Exception):
+    """The reference spent FeedOptions.max_evaluations (raised through solve_ivp)."""
+
+
 def _integrate(mach, y0: np.ndarray, t_end: float, o: FeedOptions, grid: np.ndarray):
     """Integrate with exact event handling; returns samples, step points and the event log."""
     t, y = 0.0, y0.copy()
@@ -394,18 +402,33 @@ def _integrate(mach, y0: np.ndarray, t_end: float, o: FeedOptions, grid: np.ndar
     ts, ys = [t], [y.copy()]
     gt, gy, gw = [], [], []
     recent: list[float] = []
+    spent = [0]
+
+    def rhs(t: float, y: np.ndarray) -> np.ndarray:
+        spent[0] += 1
+        if spent[0] > o.max_evaluations:
+            raise _BudgetSpent
+        return mach.rhs(t, y)
+
     while t < t_end:
-        sol = solve_ivp(
-            mach.rhs,
-            (t, t_end),
-            y,
-            method="DOP853",
-            rtol=o.rtol,
-            atol=o.atol,
-            events=mach.events(),
-            dense_output=True,
-            max_step=o.max_step,
-        )
+        try:
+            sol = solve_ivp(
+                rhs,
+                (t, t_end),
+                y,
+                method="DOP853",
+                rtol=o.rtol,
+                atol=o.atol,
+                events=mach.events(),
+                dense_output=True,
+                max_step=o.max_step,
+            )
+        except _BudgetSpent:
+            raise RuntimeError(
+                f"press feed reference: {o.max_evaluations} evaluations spent by t = {t:.6g} s "
+                "of its explicit integration (the model is too stiff for it: a very small "
+                "inertia or a very stiff coupler or clutch)"
+            ) from None
         if sol.status == -1:
             raise RuntimeError(f"press feed reference: {sol.message}")
         t_stop = sol.t[-1]
