@@ -310,7 +310,7 @@ def _model_halted(model: EventModel) -> bool:
 
 def _fire_at_instant(
     model: EventModel, y: list[float], first: int, t: float, g_start: Sequence[float]
-) -> tuple[list[float], int]:
+) -> tuple[list[float], int, Sequence[float]]:
     """Handle event ``first`` at t, then every other event of the same instant.
 
     An indicator that was armed (>= 0) at the step start and is past zero once an event
@@ -318,12 +318,15 @@ def _fire_at_instant(
     pushed across by that event's change of state.  Either way it fires here: after the
     first, in index order, each once, every one seeing the state the previous one left.
     Without this it would start the next step below zero and never fire (two crossings
-    at one instant would lose one).  Returns the state and the number of events fired.
+    at one instant would lose one).  Returns the state, the number of events fired and
+    the indicators there (the next step starts from them).
     """
     y = model.event(y, first, t)
     fired = {first}
-    while not _model_halted(model):
+    while True:
         g = model.indicators(y)
+        if _model_halted(model):
+            break
         nxt = next(
             (
                 j
@@ -336,7 +339,7 @@ def _fire_at_instant(
             break
         y = model.event(y, nxt, t)
         fired.add(nxt)
-    return y, len(fired)
+    return y, len(fired), g
 
 
 def advance(
@@ -433,9 +436,8 @@ def advance(
         t += th_best
         if th_best > 0.0 and accept is not None:
             accept(y, t)
-        y, fired = _fire_at_instant(model, y, first, t, g0)
+        y, fired, g0 = _fire_at_instant(model, y, first, t, g0)
         k1 = deriv(y)
-        g0 = model.indicators(y)
         t_event = t
         if t_first < 0.0:
             t_first = t

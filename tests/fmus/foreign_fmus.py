@@ -56,6 +56,7 @@ import sys
 import tempfile
 import uuid
 import zipfile
+from collections.abc import Callable
 from pathlib import Path
 from xml.dom.minidom import parseString
 from xml.etree import ElementTree as ET
@@ -184,25 +185,59 @@ def build_torsion_body(
     """
     if fault is not None and fault not in FAULTS:
         raise ValueError(f"unknown fault {fault!r}; expected one of {FAULTS}")
+    name = MODEL_IDENTIFIER + ("" if can_get_set_state else "-nostate")
+    name += "-deg" if phi0_in_degrees else ""
+    name += "-flags" if flags else ""
+    defines = [
+        *(["-DTORSION_BODY_FMU_STATE"] if can_get_set_state else []),
+        *(["-DTORSION_BODY_PHI0_DEG"] if phi0_in_degrees else []),
+        *(["-DTORSION_BODY_FLAGS"] if flags else []),
+        *(
+            [
+                f"-DTORSION_BODY_FAULT=FAULT_{fault.upper()}",
+                f"-DTORSION_BODY_FAULT_TIME={fault_time!r}",
+            ]
+            if fault
+            else []
+        ),
+    ]
+    return _build_c_fmu(
+        TORSION_BODY_SOURCE,
+        MODEL_IDENTIFIER,
+        "TORSION_BODY_GUID",
+        defines,
+        lambda guid: torsion_body_model_description(
+            guid, can_get_set_state, phi0_in_degrees, flags
+        ),
+        Path(dest) / (name + (f"-{fault}" if fault else "") + ".fmu"),
+        with_source=True,
+    )
+
+
+def _build_c_fmu(
+    source: Path,
+    identifier: str,
+    guid_macro: str,
+    defines: list[str],
+    model_description: Callable[[str], bytes | str],
+    target: Path,
+    with_source: bool = False,
+) -> Path:
+    """Compile one C source into an FMI 2.0 co-simulation binary (its GUID passed as the
+    macro ``guid_macro``) and pack it with its modelDescription.xml as ``target``."""
     compiler = c_compiler()
     if compiler is None:
         raise ForeignFmuError("no C compiler (cc, gcc or $CC) on PATH")
     platform_dir, suffix = fmi2_platform()
-    dest = Path(dest)
-    dest.mkdir(parents=True, exist_ok=True)
+    target.parent.mkdir(parents=True, exist_ok=True)
     guid = "{" + str(uuid.uuid4()) + "}"
-    name = MODEL_IDENTIFIER + ("" if can_get_set_state else "-nostate")
-    name += "-deg" if phi0_in_degrees else ""
-    name += "-flags" if flags else ""
-    target = dest / (name + (f"-{fault}" if fault else "") + ".fmu")
-
-    with tempfile.TemporaryDirectory(prefix="torsion_body_") as tmp:
-        library = Path(tmp) / (MODEL_IDENTIFIER + suffix)
+    with tempfile.TemporaryDirectory(prefix=f"{identifier}_") as tmp:
+        library = Path(tmp) / (identifier + suffix)
         command = [
             compiler,
             "-std=c99",
             "-O2",
-            # no fused multiply-add: the Python reference must see the same roundings
+            # no fused multiply-add: the Python references must see the same roundings
             "-ffp-contract=off",
             "-fPIC",
             "-shared",
@@ -210,19 +245,9 @@ def build_torsion_body(
             "-Wall",
             "-Wextra",
             f"-I{fmi_headers_dir()}",
-            f'-DTORSION_BODY_GUID="{guid}"',
-            *(["-DTORSION_BODY_FMU_STATE"] if can_get_set_state else []),
-            *(["-DTORSION_BODY_PHI0_DEG"] if phi0_in_degrees else []),
-            *(["-DTORSION_BODY_FLAGS"] if flags else []),
-            *(
-                [
-                    f"-DTORSION_BODY_FAULT=FAULT_{fault.upper()}",
-                    f"-DTORSION_BODY_FAULT_TIME={fault_time!r}",
-                ]
-                if fault
-                else []
-            ),
-            str(TORSION_BODY_SOURCE),
+            f'-D{guid_macro}="{guid}"',
+            *defines,
+            str(source),
             "-o",
             str(library),
             "-lm",
@@ -230,15 +255,15 @@ def build_torsion_body(
         result = subprocess.run(command, capture_output=True, text=True)
         if result.returncode != 0:
             raise ForeignFmuError(
-                f"compiling {TORSION_BODY_SOURCE.name} failed:\n{' '.join(command)}\n"
+                f"compiling {source.name} failed:\n{' '.join(command)}\n"
                 f"{result.stdout}{result.stderr}"
             )
-        xml = torsion_body_model_description(guid, can_get_set_state, phi0_in_degrees, flags)
         partial = target.with_suffix(".fmu.part")
         with zipfile.ZipFile(partial, "w", zipfile.ZIP_DEFLATED) as z:
-            z.writestr("modelDescription.xml", xml)
+            z.writestr("modelDescription.xml", model_description(guid))
             z.write(library, f"binaries/{platform_dir}/{library.name}")
-            z.write(TORSION_BODY_SOURCE, f"sources/{TORSION_BODY_SOURCE.name}")
+            if with_source:
+                z.write(source, f"sources/{source.name}")
         partial.replace(target)
     return target
 
@@ -521,39 +546,14 @@ PI_CONTROLLER_VARIABLES = (
 def build_pi_controller(dest: Path) -> Path:
     """Compile PiController (its initialization fails unless the set point u_s is 0) and
     pack it as ``dest/PiController.fmu``; return its path."""
-    compiler = c_compiler()
-    if compiler is None:
-        raise ForeignFmuError("no C compiler (cc, gcc or $CC) on PATH")
-    platform_dir, suffix = fmi2_platform()
-    dest = Path(dest)
-    dest.mkdir(parents=True, exist_ok=True)
-    guid = "{" + str(uuid.uuid4()) + "}"
-    target = dest / "PiController.fmu"
-    with tempfile.TemporaryDirectory(prefix="pi_controller_") as tmp:
-        library = Path(tmp) / ("PiController" + suffix)
-        command = [
-            compiler,
-            "-std=c99",
-            "-O2",
-            "-ffp-contract=off",
-            "-fPIC",
-            "-shared",
-            "-Wall",
-            f"-I{fmi_headers_dir()}",
-            f'-DPI_CONTROLLER_GUID="{guid}"',
-            str(PI_CONTROLLER_SOURCE),
-            "-o",
-            str(library),
-        ]
-        result = subprocess.run(command, capture_output=True, text=True)
-        if result.returncode != 0:
-            raise ForeignFmuError(f"compiling {PI_CONTROLLER_SOURCE.name} failed:\n{result.stderr}")
-        partial = target.with_suffix(".fmu.part")
-        with zipfile.ZipFile(partial, "w", zipfile.ZIP_DEFLATED) as z:
-            z.writestr("modelDescription.xml", _pi_controller_model_description(guid))
-            z.write(library, f"binaries/{platform_dir}/{library.name}")
-        partial.replace(target)
-    return target
+    return _build_c_fmu(
+        PI_CONTROLLER_SOURCE,
+        "PiController",
+        "PI_CONTROLLER_GUID",
+        [],
+        _pi_controller_model_description,
+        Path(dest) / "PiController.fmu",
+    )
 
 
 def _pi_controller_model_description(guid: str) -> bytes:
