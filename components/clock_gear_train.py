@@ -104,6 +104,14 @@ REGIME_NAMES = {
 }
 
 
+def _slide_sign(slide: float, sign: int, crossing: bool) -> int:
+    """Sliding sign of a mesh from its sliding velocity; exactly at a pitch point +1, or at
+    a crossing there the sign beyond it."""
+    if slide != 0.0:
+        return 1 if slide > 0.0 else -1
+    return -sign if crossing else 1
+
+
 class ClockTrainPhysics:
     """Kinematics, contact statics and affine response of the clock train; holds the mode.
 
@@ -181,15 +189,18 @@ class ClockTrainPhysics:
         self.pieces = ((k1, ph1, 1), (k2, ph2, 1))
         self._settle(phi)
 
-    def _settle(self, phi: float) -> None:
+    def _settle(self, phi: float, crossing: bool = False) -> None:
         """Step each mesh to the piece ahead while phi is past the bound ahead, and set the
         sliding signs from phi.  Works on the indicators themselves, so a located crossing
-        (indicator just below zero, however little) always moves on."""
+        (indicator just below zero, however little) always moves on; so does one exactly
+        on its surface when ``crossing`` (an event that fires at a step start), which would
+        otherwise fire again at once, without end."""
         forward = self.direction > 0
         for _ in range(8):
             a1, b1, a2, b2 = self.piece_distances(phi)
             ahead = (a1, a2) if forward else (b1, b2)
-            late = [i for i in (1, 0) if ahead[i] < 0.0]  # mesh 2 first: mesh 1 follows it
+            # mesh 2 first: mesh 1 follows it
+            late = [i for i in (1, 0) if ahead[i] < 0.0 or (crossing and ahead[i] == 0.0)]
             if not late:
                 break
             i = late[0]
@@ -201,7 +212,8 @@ class ClockTrainPhysics:
             self.pieces = tuple((k, ph, sg) if j == i else self.pieces[j] for j in range(2))
         ev = self.evaluate(phi)
         self.pieces = tuple(
-            (k, ph, 1 if ev[8 + i][4] >= 0.0 else -1) for i, (k, ph, _) in enumerate(self.pieces)
+            (k, ph, _slide_sign(ev[8 + i][4], sg, crossing))
+            for i, (k, ph, sg) in enumerate(self.pieces)
         )
 
     def set_direction(self, direction: int, phi: float) -> None:
@@ -389,7 +401,7 @@ class ClockTrainPhysics:
         velocity projection.  Returns (new phi_dot, kinetic energy lost)."""
         old = self.evaluate(phi)
         pairs = (self.pieces[0][0], self.pieces[1][0])
-        self._settle(phi)
+        self._settle(phi, crossing=True)
         if (self.pieces[0][0], self.pieces[1][0]) == pairs:
             return phi_dot, 0.0
         self.handovers += 1

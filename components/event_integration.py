@@ -372,6 +372,7 @@ def advance(
     g0 = model.indicators(y)
     k1 = deriv(y)
     n_events = steps = rejected = 0
+    recent: list[int] = []  # indicators that fired first (named when it chatters)
     t_first = t_event = -1.0
     end = h_total * (1.0 - 1e-14)
     h = h_try if h_try > 0.0 else _first_step(y, k1, control)
@@ -442,8 +443,13 @@ def advance(
         if t_first < 0.0:
             t_first = t
         n_events += fired
+        recent.append(first)
         if n_events > max_events:
-            raise ComponentError("too many events inside one step (chattering)")
+            which = ", ".join(str(i) for i in sorted(set(recent[-20:])))
+            raise ComponentError(
+                f"too many events inside one step (chattering: indicators {which}, "
+                f"{t:.6g} s into the step)"
+            )
         h = h_next
         if getattr(model, "halted", False):
             break

@@ -12,8 +12,13 @@ took) gives that instead, so its receiver takes the very impulse of the step.
 
 Error.  Where a receiver reports its own copy of a sampled input (an output named after
 the input with ``_own``: the verge's copy of the escape wheel), the estimate is the copy's
-mismatch with the source at the step end, per unit step (against the source's travel in
-the step at its largest rate so far): it measures the held inputs' effect on the motion.
+mismatch with the source at the step end against the source's travel in the step: it
+measures the held inputs' effect on the motion, and the mismatches of all steps add up to
+at most the tolerance times the whole travel (the tolerance bounds the relative error in
+turns).  A speed copy (its unit the angle's per second) counts as the angle its mismatch
+moves the copy by in the step, except where the source ended the step at its own event
+(its speed jumps there); a source at rest counts as travelling a tenth of its travel at
+its largest rate so far.
 Elsewhere it is each held signal's extrapolated mean against the trapezoidal mean of its
 actual start and end values, relative to its running scale, as in Schierz, Arnold &
 Clauß, "Co-simulation with communication step size control in an FMI compatible master
@@ -59,6 +64,9 @@ MAX_ROUNDS = 4
 #: The step after an accepted one grows at most by StepControl.max_growth, and by this
 #: factor less than the estimate allows (M739 at 1e-3: 152 rejected passes against 544).
 GROWTH_SAFETY = 0.8
+#: A copied source's travel in a step is taken as at least this fraction of its travel at
+#: its largest rate so far (a wheel at rest would otherwise allow no mismatch at all).
+TRAVEL_FLOOR = 0.1
 
 
 class InputExtrapolation:
@@ -124,6 +132,39 @@ class InputExtrapolation:
         return bool(self.coefficients)
 
 
+Copy = tuple[tuple[int, int], tuple[int, int]]  # (source slot, receiver's copy slot)
+
+
+def angles_with_speeds(
+    copies: list[Copy], units: list[tuple[tuple[tuple[str, int], ...], float] | None]
+) -> list[tuple[tuple[int, int], tuple[int, int], Copy | None]]:
+    """The copies as the error estimate judges them: (source, copy, its speed's copy or
+    None).  A copy whose unit is another's (same receiver, same source FMU) per second is
+    that one's speed: its mismatch counts as the angle it moves the copy by in the step.
+    Units: each copy's base unit (exponents, factor) as ``ModelInfo.base_unit`` gives it."""
+
+    def per_second(unit):
+        if unit is None:
+            return None
+        exponents = dict(unit[0])
+        exponents["s"] = exponents.get("s", 0) - 1
+        return tuple(sorted((k, v) for k, v in exponents.items() if v)), unit[1]
+
+    speeds: dict[int, int] = {}  # index of an angle copy -> index of its speed copy
+    for a, (ca, ua) in enumerate(zip(copies, units, strict=True)):
+        rate = per_second(ua)
+        for v, (cv, uv) in enumerate(zip(copies, units, strict=True)):
+            same_pair = cv[0][0] == ca[0][0] and cv[1][0] == ca[1][0]
+            if v != a and same_pair and rate is not None and uv == rate:
+                speeds[a] = v
+    judged_as_speed = set(speeds.values())
+    return [
+        (c[0], c[1], copies[speeds[a]] if a in speeds else None)
+        for a, c in enumerate(copies)
+        if a not in judged_as_speed
+    ]
+
+
 class SinglePassMaster(RegimeAwareMaster):
     """One pass of every FMU per macro step, inputs extrapolated; see the module doc."""
 
@@ -162,6 +203,7 @@ class SinglePassMaster(RegimeAwareMaster):
         # follows the held inputs, the source the true ones: their difference at the step
         # end is the coupling error the next step start discards.
         self.copies: list[tuple[tuple[int, int], tuple[int, int]]] = []
+        units = []
         for c, src in zip(system.connections, system.connection_sources, strict=True):
             j = system.index[c.target[0]]
             own = c.target[1] + OWN_SUFFIX
@@ -169,6 +211,8 @@ class SinglePassMaster(RegimeAwareMaster):
             if src is None or c.target[1] not in model.sampled or own not in model.variables:
                 continue
             self.copies.append((src, (j, system.real_output_slot(j, own))))
+            units.append(model.base_unit(model.variables[c.target[1]].unit))
+        self.judged = angles_with_speeds(self.copies, units)
         # The held inputs of FMUs joined by such a copy are judged by it (their effect on
         # the motion, not the size of their change); the others by their extrapolation.
         covered = {j for (_, (j, _)) in self.copies} | {s[0] for (s, _) in self.copies}
@@ -240,8 +284,8 @@ class SinglePassMaster(RegimeAwareMaster):
                     h_end = reached - t
                     returned.clear()
                     returned.add(i)
-                else:
-                    returned.discard(i)
+                # One that returned in an earlier round, stepped again to that instant,
+                # ends there at its event again: it stays among those that returned.
             if not again:
                 break
         feeds = self.feeds_for(h_end, before, done)
@@ -283,13 +327,20 @@ class SinglePassMaster(RegimeAwareMaster):
         # to at most the tolerance times the source's travel at that rate.
         now = self.system.values
         smooth = not returned  # an event's jump is no rate
-        for s, (j, k) in self.copies:
+        for s, (j, k), speed in self.judged:
             a, b = start[s[0]][s[1]], now[s[0]][s[1]]
             rate = max(self.rate.get(s, 0.0), abs(b - a) / h)
             if smooth:
                 self.rate[s] = rate
-            if rate > 0.0:
-                worst = max(worst, abs(end[j][k] - b) / (tol * rate * h))
+            travel = max(abs(b - a), TRAVEL_FLOOR * rate * h)
+            if travel > 0.0:
+                miss = abs(end[j][k] - b)
+                # The angle a speed mismatch moves the copy by; not when the source ended
+                # the step at its own event (its speed jumps there: a handover's impact).
+                if speed is not None and s[0] not in returned:
+                    (vs, (vj, vk)) = speed
+                    miss = max(miss, abs(end[vj][vk] - now[vs[0]][vs[1]]) * h)
+                worst = max(worst, miss / (tol * travel))
         blind = self.error_ratio(before, self.blind) if self.blind else 0.0
         self.first_order = blind > worst or not ex.second_order
         return max(worst, blind)

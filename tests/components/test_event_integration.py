@@ -196,3 +196,22 @@ def test_an_early_return_still_fires_every_event_of_its_instant() -> None:
     assert [i for i, _ in model.fired] == [0, 1]  # both of t = 1, not the one at t = 2
     assert done.y[0] == pytest.approx(1.0, abs=1e-12)
     assert wrapper.stopped_at == pytest.approx(1.0, abs=1e-12)
+
+
+class StuckOnTheSurface:
+    """An event that leaves its indicator exactly at zero, moving on: it fires again at
+    once, without end (a model error the integrator must name, not hang on)."""
+
+    def deriv(self, y: list[float]) -> list[float]:
+        return [1.0]
+
+    def indicators(self, y: list[float]) -> tuple[float, float]:
+        return (1.0, 0.5 - y[0])
+
+    def event(self, y: list[float], index: int, t: float) -> list[float]:
+        return [0.5]
+
+
+def test_chattering_names_the_indicator_and_where() -> None:
+    with pytest.raises(ComponentError, match=r"chattering: indicators 1, 0\.5 s into the step"):
+        advance(StuckOnTheSurface(), [0.0], 2.0, StepControl(1e-8, (1.0,)), max_events=50)

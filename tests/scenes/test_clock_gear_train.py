@@ -371,3 +371,30 @@ def test_turns_to_arm_fall_as_the_escapement_center_distance_grows() -> None:
     involute_rel = (involute[1] - involute[0]) / run_m739().turns
     assert clock_rel < 0.0 and involute_rel < 0.0
     assert clock_rel / involute_rel == pytest.approx(1.0, abs=0.2), (clock_rel, involute_rel)
+
+
+def test_a_crossing_exactly_on_a_piece_bound_moves_on(monkeypatch) -> None:
+    """An event that fires at a step start with its indicator exactly zero (the step began
+    on the bound) moves to the piece beyond; staying would fire it again without end."""
+    phys = ClockTrainPhysics(mu=0.1, loss_model=LOSS_POINT)
+    phys.set_mode(PHIS[0], 1)
+    pieces = phys.pieces
+    ahead = lambda phi: phys.piece_distances(phi)[2]  # noqa: E731  mesh 2, forward
+    lo, hi = PHIS[0], PHIS[0]
+    while ahead(hi) >= 0.0:
+        lo, hi = hi, hi + 1e-3
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if ahead(mid) >= 0.0 else (lo, mid)
+    offset = ahead(lo)  # >= 0, within rounding of the bound: shift it to exactly zero
+    real = phys.piece_distances
+
+    def on_the_bound(phi: float) -> tuple[float, float, float, float]:
+        a1, b1, a2, b2 = real(phi)
+        return a1, b1, a2 - offset, b2 + offset
+
+    monkeypatch.setattr(phys, "piece_distances", on_the_bound)
+    assert phys.piece_distances(lo)[2] == 0.0
+    phys.cross(lo, 700.0)
+    assert phys.pieces[1] != pieces[1]
+    assert phys.piece_distances(lo)[2] > 0.0

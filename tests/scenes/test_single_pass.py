@@ -229,18 +229,11 @@ def test_press_feed_run3_against_its_reference(press):
     assert r.value("energy_residual") < 1e-3
 
 
-#: Not yet under the single-pass scheme: with the verge 100 times heavier the wheel stops
-#: and restarts every cycle, and at one stop (t = 0.0173 s) the verge's copy of the wheel
-#: and the train start differently, a mismatch no shorter step removes: the run ends in
-#: "chattering" (50 jumps within 1 ns).  The midpoint-hold master passes it.
-NOT_YET = pytest.mark.xfail(
-    reason="single pass: wheel stop of the heavy verge ends in chattering", strict=True
-)
 STABLE = (
     "m739_friction_zero",
     "m739_jam",
     "m739_pallet_inertia_div100",
-    pytest.param("m739_pallet_inertia_x100", marks=NOT_YET),
+    "m739_pallet_inertia_x100",
     "m739_spin_x4",
     "press_feed_brake_below_min",
     "press_feed_brake_near_min",
