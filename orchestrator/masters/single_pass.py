@@ -29,7 +29,7 @@ ends its step at its first event and says where in ``t_reached``; such FMUs are 
 first (those giving step means before their receivers), each to where the earliest so far
 stopped, and the others once to that instant: landing on a switch costs one doStep of
 each FMU, none retaken.  When one stops before an instant the ones before it were stepped
-to, all are stepped again to it.  A switch that only an indicator or a reported event
+to, those are stepped again to it (it stays where it stopped, with the inputs it had).  A switch that only an indicator or a reported event
 time of another FMU shows is located and landed on as in the midpoint master.
 """
 
@@ -267,9 +267,13 @@ class SinglePassMaster(RegimeAwareMaster):
         h_end = h
         returned = self.returned = set()
         for round_ in range(MAX_ROUNDS):
-            done: set[int] = set()
+            # The one that ended at its event is at the instant the others are stepped
+            # again to: kept, with the inputs it had (the copy's mismatch judges them).
+            done: set[int] = set(returned)
             again = False
             for i in self.early:
+                if i in done:
+                    continue
                 if round_ > 0:
                     system.instances[i].set_state(state[i])
                     self.stats.rollbacks += 1
