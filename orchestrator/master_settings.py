@@ -60,7 +60,7 @@ class FixedStepSettings:
 
 
 @dataclass(frozen=True)
-class StepControl:
+class MasterStepControl:
     """The regime-aware master's step-size controller: its constants, named."""
 
     max_growth: float = 4.0  # largest factor a step grows by after an accepted one
@@ -109,7 +109,7 @@ class RegimeAwareSettings:
     max_iterations: int = setting(10)  # exchange rounds at a switching instant
     max_events_per_step: int = setting(50)  # switches at (nearly) one instant: chattering
     input_hold: str = setting("midpoint", choices=("start", "midpoint", "extrapolated"))
-    control: StepControl = StepControl()
+    control: MasterStepControl = MasterStepControl()
 
     @property
     def midpoint(self) -> bool:

@@ -13,8 +13,8 @@ from orchestrator.master_settings import (
     SETTING_KINDS,
     SETTINGS,
     FixedStepSettings,
+    MasterStepControl,
     RegimeAwareSettings,
-    StepControl,
 )
 from orchestrator.masters import MASTERS, TOLERANCE_MASTERS
 from orchestrator.scenario import load_scene
@@ -41,14 +41,14 @@ def test_scene_settings_are_typed_with_defaults_filled_in() -> None:
     assert s.event_tolerance == 1e-10 and s.min_step == 1e-14
     assert s.first_step == scene.master.step
     assert s.max_step == min(100.0 * scene.master.step, scene.stop - scene.start)
-    assert s.midpoint and s.control == StepControl()
+    assert s.midpoint and s.control == MasterStepControl()
     # A setting another master uses is accepted and ignored.
     jacobi = load_scene(TWO, {"master.algorithm": "jacobi", "master.tolerance": 1e-3})
     assert jacobi.master.settings == FixedStepSettings(jacobi.master.step)
 
 
 def test_step_control_factors() -> None:
-    c = StepControl()
+    c = MasterStepControl()
     assert c.grow(0.0, False) == c.max_growth
     assert c.grow(1e-9, True) == c.max_growth
     assert c.shrink(1e9, False) == c.max_shrink
