@@ -6,6 +6,12 @@ else.  Every key a scene may write is a field of some master's settings, declare
 scenario loader only converts what the scene wrote into those kinds.  A key that another
 master uses is accepted and ignored (``--set master.algorithm=jacobi`` on a regime-aware
 scene keeps working).
+
+Each master reads its step from its own key: ``master.step`` is the macro step of the
+fixed-step masters, ``master.first_step`` the regime-aware master's first step (and the
+step after a switch).  A scene that gives only the other master's key (one switched with
+``--set master.algorithm=...``) lends it: Jacobi on a regime-aware scene steps at its
+first step, the regime-aware master on a Jacobi scene starts at its macro step.
 """
 
 from __future__ import annotations
@@ -13,10 +19,10 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, ClassVar
 
-#: Keys every master has; the others are fields of the masters' settings.
-COMMON_KEYS = ("algorithm", "step", "order")
+#: Keys every master has; the others are its step (STEP_KEYS) and fields of its settings.
+COMMON_KEYS = ("algorithm", "order")
 
 
 class SettingError(ValueError):
@@ -52,7 +58,8 @@ def _kinds(cls: type) -> dict[str, SettingKind]:
 class FixedStepSettings:
     """Jacobi and Gauss–Seidel: one macro step, nothing else to set."""
 
-    step: float  # macro step [s]
+    STEP_KEY: ClassVar[str] = "step"
+    step: float  # master.step: the macro step [s]
 
     @classmethod
     def from_options(cls, step: float, duration: float, options: dict[str, Any]):
@@ -101,7 +108,8 @@ class MasterStepControl:
 class RegimeAwareSettings:
     """Error-controlled steps that land on every regime switch (masters/regime_aware.py)."""
 
-    first_step: float  # master.step: the first step, and the step after a switch [s]
+    STEP_KEY: ClassVar[str] = "first_step"
+    first_step: float  # master.first_step: the first step, and the step after a switch [s]
     tolerance: float = setting(1e-4, "1")  # coupling error per step, relative to scale
     event_tolerance: float = setting(1e-10, "s")  # how closely a step lands on a switch
     min_step: float = setting(1e-14, "s")
@@ -137,6 +145,9 @@ SETTINGS: dict[str, type] = {
     "regime-aware": RegimeAwareSettings,
 }
 ALGORITHMS = tuple(SETTINGS)
+#: The key each master reads its step from, by algorithm (see the module docstring).
+STEP_KEY: dict[str, str] = {a: cls.STEP_KEY for a, cls in SETTINGS.items()}
+STEP_KEYS = tuple(dict.fromkeys(STEP_KEY.values()))
 #: Masters whose accuracy is set by master.tolerance rather than by the macro step.
 TOLERANCE_MASTERS = tuple(a for a, cls in SETTINGS.items() if "tolerance" in _kinds(cls))
 #: Every key a scene's [master] table may hold beyond COMMON_KEYS, with its kind.

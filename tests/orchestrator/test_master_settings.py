@@ -73,3 +73,43 @@ def test_bad_settings_name_the_key(overrides: dict, key: str, fragment: str) -> 
     with pytest.raises(ScenarioError) as info:
         load_scene(TWO, {"master.algorithm": "regime-aware", **overrides})
     assert f"[{key}]" in str(info.value) and fragment in str(info.value)
+
+
+M739 = SCENARIOS / "m739.toml"
+
+
+def test_each_master_reads_its_own_step_key() -> None:
+    """master.step is the fixed-step masters' macro step, master.first_step the
+    regime-aware master's first step; a scene that gives only one lends it to the other."""
+    m739 = load_scene(M739)  # regime-aware, first_step = "1 us"
+    assert m739.master.settings.first_step == 1e-6 and m739.master.step == 1e-6
+    jacobi = load_scene(M739, {"master.algorithm": "jacobi"})
+    assert jacobi.master.settings == FixedStepSettings(1e-6)
+    both = {"master.step": 5e-6}
+    assert load_scene(M739, both).master.settings.first_step == 1e-6
+    assert load_scene(M739, both).master.step == 5e-6
+    assert load_scene(M739, {**both, "master.algorithm": "jacobi"}).master.settings.step == 5e-6
+    two = load_scene(TWO, {"master.algorithm": "regime-aware"})  # jacobi, step = "0.1 ms"
+    assert two.master.settings.first_step == two.master.step == 1e-4
+
+
+@pytest.mark.parametrize(
+    ("overrides", "key", "fragment"),
+    [
+        ({"master.first_step": "-1 us"}, "master.first_step", "must be positive"),
+        ({"master.first_step": "1 s"}, "master.first_step", "longer than the run"),
+        ({"master.step": "0 s"}, "master.step", "must be positive"),
+    ],
+)
+def test_bad_steps_name_their_key(overrides: dict, key: str, fragment: str) -> None:
+    with pytest.raises(ScenarioError) as info:
+        load_scene(M739, overrides)
+    assert f"[{key}]" in str(info.value) and fragment in str(info.value)
+
+
+def test_a_missing_step_names_the_masters_own_key(tmp_path: Path) -> None:
+    text = M739.read_text().replace('first_step = "1 us"\n', "")
+    path = tmp_path / "m739.toml"
+    path.write_text(text)
+    with pytest.raises(ScenarioError, match=r"\[master\.first_step\] missing; expected the first"):
+        load_scene(path)
