@@ -80,10 +80,10 @@ class MasterStepControl:
     event_time_slack: float = 1e-12  # relative: a reported event time this past the end counts
     settle_window: float = 10.0  # switches within this many event tolerances: one instant
     # After a switch into regimes where every accepted step so far had zero coupling error
-    # (nothing the held inputs reach is exchanged, e.g. a verge in free flight), restart at
-    # this fraction of the step proposed there last, not at master.step: the ramp from
-    # master.step bought nothing there.  Not the whole step: the next switch is usually
-    # nearer (at 1, M739 took 9 % more doSteps than at 1/4).
+    # (nothing the held inputs reach is exchanged, e.g. a verge in free flight), the restart
+    # is this fraction of the step proposed there last: a ramp up from master.first_step
+    # buys nothing where the error is zero, and the next switch is usually nearer than the
+    # whole step (the measurements: docs/measurements.md).
     zero_error_restart: float = 0.25
 
     def factor(self, ratio: float, first_order: bool) -> float:
