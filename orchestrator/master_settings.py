@@ -145,9 +145,8 @@ SETTINGS: dict[str, type] = {
     "regime-aware": RegimeAwareSettings,
 }
 ALGORITHMS = tuple(SETTINGS)
-#: The key each master reads its step from, by algorithm (see the module docstring).
-STEP_KEY: dict[str, str] = {a: cls.STEP_KEY for a, cls in SETTINGS.items()}
-STEP_KEYS = tuple(dict.fromkeys(STEP_KEY.values()))
+#: The keys the masters read their step from (see the module docstring).
+STEP_KEYS = tuple(dict.fromkeys(cls.STEP_KEY for cls in SETTINGS.values()))
 #: Masters whose accuracy is set by master.tolerance rather than by the macro step.
 TOLERANCE_MASTERS = tuple(a for a, cls in SETTINGS.items() if "tolerance" in _kinds(cls))
 #: Every key a scene's [master] table may hold beyond COMMON_KEYS, with its kind.
@@ -186,6 +185,11 @@ def read_options(node: dict[str, Any], to_si: Callable[[Any, str, str], float]) 
     if low is not None and high is not None and high < low:
         raise SettingError("max_step", f"{high:g} s is less than master.min_step ({low:g} s)")
     return options
+
+
+def step_key(algorithm: str) -> str:
+    """The key ``algorithm`` reads its step from (its settings' STEP_KEY)."""
+    return SETTINGS[algorithm].STEP_KEY
 
 
 def master_settings(

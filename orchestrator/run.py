@@ -304,7 +304,7 @@ def _versions() -> dict[str, str | None]:
 def _metadata(scene: Scene, fmu_paths: dict[str, Path]) -> dict[str, Any]:
     versions = dict(_versions())
     signals = scene_signals(scene)
-    step_key, step = scene.master.own_step
+    own_key, step = scene.master.own_step
     return {
         **({"signals": signals.provenance()} if signals else {}),  # a CSV file's sha256
         "scene_file": str(scene.path),
@@ -315,7 +315,7 @@ def _metadata(scene: Scene, fmu_paths: dict[str, Path]) -> dict[str, Any]:
         },
         "master": {
             "algorithm": scene.master.algorithm,
-            step_key: step,
+            own_key: step,
             "order": list(scene.master.order),
             **scene.master.options,
         },

@@ -22,13 +22,13 @@ from orchestrator.master_settings import (
     ALGORITHMS,
     COMMON_KEYS,
     SETTING_KINDS,
-    STEP_KEY,
     STEP_KEYS,
     FixedStepSettings,
     MasterSettings,
     SettingError,
     master_settings,
     read_options,
+    step_key,
 )
 from orchestrator.model_info import ModelInfo, ModelInfoError, VariableInfo, model_info
 from orchestrator.scenes import ANALYSES, REFERENCES, family, shared_parameters
@@ -91,7 +91,7 @@ class MasterSpec:
     @property
     def own_step(self) -> tuple[str, float]:
         """The step key this master reads (step or first_step) and the step it takes."""
-        key = STEP_KEY[self.algorithm]
+        key = step_key(self.algorithm)
         return key, getattr(self.settings, key, self.step)
 
 
@@ -650,11 +650,11 @@ class _Loader:
                     raise self.fail(
                         f"master.{k}", f"{value} s is longer than the run ({duration} s)"
                     )
-        own = STEP_KEY[algorithm]
+        own = step_key(algorithm)
         if not steps:
             raise self.fail(f"master.{own}", f"missing; expected the {STEP_MEANING[own]}")
         used = own if own in steps else next(iter(steps))  # another master's key is lent
-        step, step_key = steps[used], f"master.{used}"
+        step, used_key = steps[used], f"master.{used}"
         order = node.get("order", list(fmus))
         if not (
             isinstance(order, list)
@@ -670,14 +670,14 @@ class _Loader:
         largest = getattr(settings, "max_step", None)  # a master that varies its step
         if largest is None and duration / step > MAX_STEPS and not self.force:
             raise self.fail(
-                step_key,
+                used_key,
                 f"{step:g} s over {duration:g} s is {duration / step:.3g} macro steps, more "
                 f"than the limit {MAX_STEPS:.0e}: the run would not finish (--force to run it)",
             )
         if largest is not None:
             if duration / largest > MAX_STEPS and not self.force:
                 raise self.fail(
-                    "master.max_step" if "max_step" in options else step_key,
+                    "master.max_step" if "max_step" in options else used_key,
                     f"steps of at most {largest:g} s over {duration:g} s are at least "
                     f"{duration / largest:.3g} macro steps, more than the limit "
                     f"{MAX_STEPS:.0e}: the run would not finish (--force to run it)",
