@@ -23,7 +23,7 @@ import math
 from dataclasses import dataclass
 
 from .base import COMMON_OUTPUTS, Component, ComponentError, SnapshotPlan, Variable
-from .event_integration import advance, integration_variables, step_control
+from .event_integration import advance, integration_step_control, integration_variables
 from .press_feed_data import (
     APP_H_FOURIER,
     COUPLER_DAMPING_FACTOR,
@@ -366,7 +366,7 @@ class CrankCouplerDrive(Component):
         if self.crank_rpm() <= 0.0:
             raise ComponentError("CrankCouplerDrive: rpm must be positive")
         self._m, coupler = self._build()
-        self._control = step_control(self, STATE_SCALES)
+        self._control = integration_step_control(self, STATE_SCALES)
         self._h_next = 0.0
         self._gauge, self._at_b = strain_factors(coupler)
         exact = ExactRSSR(

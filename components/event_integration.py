@@ -38,7 +38,7 @@ class EventModel(Protocol):
 
 
 @dataclass(frozen=True)
-class StepControl:
+class IntegrationStepControl:
     """Accuracy of the integration.
 
     The local error of each state component i is held below
@@ -88,9 +88,11 @@ def integration_variables(h_max: float) -> tuple[Variable, Variable]:
     return tolerance, replace(largest, start=h_max)
 
 
-def step_control(component: object, scales: tuple[float, ...]) -> StepControl:
-    """The StepControl of a component from its INTEGRATION_VARIABLES."""
-    return StepControl(
+def integration_step_control(
+    component: object, scales: tuple[float, ...]
+) -> IntegrationStepControl:
+    """The IntegrationStepControl of a component from its INTEGRATION_VARIABLES."""
+    return IntegrationStepControl(
         float(component.tolerance),  # type: ignore[attr-defined]
         scales,
         float(component.h_max),  # type: ignore[attr-defined]
@@ -162,7 +164,7 @@ def _dp5_step(
     y: list[float],
     k1: list[float],
     h: float,
-    control: StepControl,
+    control: IntegrationStepControl,
 ) -> _Step:
     n = len(y)
     rng = range(n)
@@ -270,7 +272,7 @@ def _restep(
     th: float,
     y_dense: list[float],
     idx: int,
-    control: StepControl,
+    control: IntegrationStepControl,
     tol_t: float,
 ) -> tuple[float, list[float]]:
     """The event state by one step of length th from the step start instead of from the
@@ -289,7 +291,7 @@ def _restep(
     return th, y_dense
 
 
-def _first_step(y: list[float], k1: list[float], control: StepControl) -> float:
+def _first_step(y: list[float], k1: list[float], control: IntegrationStepControl) -> float:
     """A first step from the sizes of y and y' (HNW 1993, II.4, the simple part)."""
     n = len(y)
     sc = [control.rtol * (control.scales[i] + abs(y[i])) for i in range(n)]
@@ -346,7 +348,7 @@ def advance(
     model: EventModel,
     y: list[float],
     h_total: float,
-    control: StepControl,
+    control: IntegrationStepControl,
     h_try: float = 0.0,
     tol_t: float = 1e-14,
     max_events: int = 2000,

@@ -9,7 +9,7 @@ from typing import Any
 
 from .base import Component, SnapshotPlan
 from .early_return import UntilFirstEvent, reached
-from .event_integration import advance, step_control
+from .event_integration import advance, integration_step_control
 
 #: Magnitudes below which the integration controls the state [phi, phi_d, W] absolutely:
 #: rad, rad/s, J.
@@ -99,7 +99,7 @@ class TrainComponent(Component):
 
     def _start_integration(self) -> None:
         """The integration accuracy from the parameters (initialize calls it first)."""
-        self._control = step_control(self, STATE_SCALES)
+        self._control = integration_step_control(self, STATE_SCALES)
         self._h_next = 0.0
 
     def _apply_inputs(self) -> None:

@@ -57,7 +57,7 @@ from typing import Any
 from .base import Component, ComponentError, SnapshotPlan, Variable, common_outputs
 from .early_return import EARLY_RETURN_VARIABLES, UntilFirstEvent, reached
 from .escape_wheel import ESCAPE_WHEEL_PORT
-from .event_integration import INTEGRATION_VARIABLES, advance, step_control
+from .event_integration import INTEGRATION_VARIABLES, advance, integration_step_control
 from .m739_data import M739, M739Data
 from .verge_geometry import (
     TWO_PI,
@@ -996,7 +996,7 @@ class VergeEscapement(Component):
 
     def initialize(self, t0: float) -> None:
         self.check_parameters()  # a NaN spin or restitution is named here, not met later
-        self._control = step_control(self, STATE_SCALES)
+        self._control = integration_step_control(self, STATE_SCALES)
         self._h_next = 0.0
         data = escapement_data(self.center_distance, self.phi_local_start, self.pallet_inertia)
         k = VergeConstants(data, self.mu1, self.mu, self.spin, self.e_rest)

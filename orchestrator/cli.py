@@ -502,3 +502,11 @@ def _report(args: argparse.Namespace) -> int:
     keys = ("scene", "status", "message", "time_reached", "crash", "headline", "notes", "stats")
     print(json.dumps({k: summary[k] for k in keys if k in summary}, indent=2))
     return 0
+
+
+if __name__ == "__main__":
+    # ``python -m orchestrator.cli`` runs the command as ``python -m orchestrator`` does,
+    # through orchestrator.entry (its signal handling while the modules load and after).
+    import runpy
+
+    runpy.run_module("orchestrator", run_name="__main__")

@@ -6,6 +6,12 @@ else.  Every key a scene may write is a field of some master's settings, declare
 scenario loader only converts what the scene wrote into those kinds.  A key that another
 master uses is accepted and ignored (``--set master.algorithm=jacobi`` on a regime-aware
 scene keeps working).
+
+Each master reads its step from its own key: ``master.step`` is the macro step of the
+fixed-step masters, ``master.first_step`` the regime-aware master's first step (and the
+step after a switch).  A scene that gives only the other master's key (one switched with
+``--set master.algorithm=...``) lends it: Jacobi on a regime-aware scene steps at its
+first step, the regime-aware master on a Jacobi scene starts at its macro step.
 """
 
 from __future__ import annotations
@@ -13,10 +19,10 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, ClassVar
 
-#: Keys every master has; the others are fields of the masters' settings.
-COMMON_KEYS = ("algorithm", "step", "order")
+#: Keys every master has; the others are its step (STEP_KEYS) and fields of its settings.
+COMMON_KEYS = ("algorithm", "order")
 
 
 class SettingError(ValueError):
@@ -52,7 +58,8 @@ def _kinds(cls: type) -> dict[str, SettingKind]:
 class FixedStepSettings:
     """Jacobi and Gauss–Seidel: one macro step, nothing else to set."""
 
-    step: float  # macro step [s]
+    STEP_KEY: ClassVar[str] = "step"
+    step: float  # master.step: the macro step [s]
 
     @classmethod
     def from_options(cls, step: float, duration: float, options: dict[str, Any]):
@@ -60,7 +67,7 @@ class FixedStepSettings:
 
 
 @dataclass(frozen=True)
-class StepControl:
+class MasterStepControl:
     """The regime-aware master's step-size controller: its constants, named."""
 
     max_growth: float = 4.0  # largest factor a step grows by after an accepted one
@@ -73,10 +80,10 @@ class StepControl:
     event_time_slack: float = 1e-12  # relative: a reported event time this past the end counts
     settle_window: float = 10.0  # switches within this many event tolerances: one instant
     # After a switch into regimes where every accepted step so far had zero coupling error
-    # (nothing the held inputs reach is exchanged, e.g. a verge in free flight), restart at
-    # this fraction of the step proposed there last, not at master.step: the ramp from
-    # master.step bought nothing there.  Not the whole step: the next switch is usually
-    # nearer (at 1, M739 took 9 % more doSteps than at 1/4).
+    # (nothing the held inputs reach is exchanged, e.g. a verge in free flight), the restart
+    # is this fraction of the step proposed there last: a ramp up from master.first_step
+    # buys nothing where the error is zero, and the next switch is usually nearer than the
+    # whole step (the measurements: docs/measurements.md).
     zero_error_restart: float = 0.25
 
     def factor(self, ratio: float, first_order: bool) -> float:
@@ -101,7 +108,8 @@ class StepControl:
 class RegimeAwareSettings:
     """Error-controlled steps that land on every regime switch (masters/regime_aware.py)."""
 
-    first_step: float  # master.step: the first step, and the step after a switch [s]
+    STEP_KEY: ClassVar[str] = "first_step"
+    first_step: float  # master.first_step: the first step, and the step after a switch [s]
     tolerance: float = setting(1e-4, "1")  # coupling error per step, relative to scale
     event_tolerance: float = setting(1e-10, "s")  # how closely a step lands on a switch
     min_step: float = setting(1e-14, "s")
@@ -109,7 +117,7 @@ class RegimeAwareSettings:
     max_iterations: int = setting(10)  # exchange rounds at a switching instant
     max_events_per_step: int = setting(50)  # switches at (nearly) one instant: chattering
     input_hold: str = setting("midpoint", choices=("start", "midpoint", "extrapolated"))
-    control: StepControl = StepControl()
+    control: MasterStepControl = MasterStepControl()
 
     @property
     def midpoint(self) -> bool:
@@ -137,6 +145,8 @@ SETTINGS: dict[str, type] = {
     "regime-aware": RegimeAwareSettings,
 }
 ALGORITHMS = tuple(SETTINGS)
+#: The keys the masters read their step from (see the module docstring).
+STEP_KEYS = tuple(dict.fromkeys(cls.STEP_KEY for cls in SETTINGS.values()))
 #: Masters whose accuracy is set by master.tolerance rather than by the macro step.
 TOLERANCE_MASTERS = tuple(a for a, cls in SETTINGS.items() if "tolerance" in _kinds(cls))
 #: Every key a scene's [master] table may hold beyond COMMON_KEYS, with its kind.
@@ -175,6 +185,11 @@ def read_options(node: dict[str, Any], to_si: Callable[[Any, str, str], float]) 
     if low is not None and high is not None and high < low:
         raise SettingError("max_step", f"{high:g} s is less than master.min_step ({low:g} s)")
     return options
+
+
+def step_key(algorithm: str) -> str:
+    """The key ``algorithm`` reads its step from (its settings' STEP_KEY)."""
+    return SETTINGS[algorithm].STEP_KEY
 
 
 def master_settings(

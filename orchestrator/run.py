@@ -232,12 +232,12 @@ def _analyse(
             )
         elif residual is not None:
             quantities["energy_residual"] = residual
-    if scene.analysis and status == "completed":
-        with _noted(notes, f"analysis {scene.analysis!r}", header):
-            quantities.update(ANALYSES[scene.analysis](scene, header, data, scene.analysis_options))
-        if plots and scene.analysis in PLOTS and len(data) > 1:
-            with _noted(notes, f"plot of {scene.analysis!r}", header):
-                PLOTS[scene.analysis](scene, header, data, out / f"{scene.name}.png")
+    if scene.family and status == "completed":
+        with _noted(notes, f"analysis {scene.family!r}", header):
+            quantities.update(ANALYSES[scene.family](scene, header, data, scene.report_options))
+        if plots and scene.family in PLOTS and len(data) > 1:
+            with _noted(notes, f"plot of {scene.family!r}", header):
+                PLOTS[scene.family](scene, header, data, out / f"{scene.name}.png")
     accuracy: dict[str, float] = {}
     ref = None
     if scene.reference and status == "completed" and compare_reference:
@@ -304,17 +304,18 @@ def _versions() -> dict[str, str | None]:
 def _metadata(scene: Scene, fmu_paths: dict[str, Path]) -> dict[str, Any]:
     versions = dict(_versions())
     signals = scene_signals(scene)
+    own_key, step = scene.master.own_step
     return {
         **({"signals": signals.provenance()} if signals else {}),  # a CSV file's sha256
         "scene_file": str(scene.path),
         "scene_sha256": file_sha256(scene.path),
         "fmus": {
-            name: {"file": p.name, "sha256": file_sha256(p), "model": scene.fmus[name].fmu}
+            name: {"file": p.name, "sha256": file_sha256(p), "model": scene.fmus[name].fmu_name}
             for name, p in fmu_paths.items()
         },
         "master": {
             "algorithm": scene.master.algorithm,
-            "step": scene.master.step,
+            own_key: step,
             "order": list(scene.master.order),
             **scene.master.options,
         },

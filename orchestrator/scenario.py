@@ -22,10 +22,13 @@ from orchestrator.master_settings import (
     ALGORITHMS,
     COMMON_KEYS,
     SETTING_KINDS,
+    STEP_KEYS,
+    FixedStepSettings,
     MasterSettings,
     SettingError,
     master_settings,
     read_options,
+    step_key,
 )
 from orchestrator.model_info import ModelInfo, ModelInfoError, VariableInfo, model_info
 from orchestrator.scenes import ANALYSES, REFERENCES, family, shared_parameters
@@ -53,7 +56,7 @@ MAX_STEPS = 1e8
 @dataclass(frozen=True)
 class FmuSpec:
     instance: str
-    fmu: str  # our component's name in fmus.registry, or the FMU file's model name
+    fmu_name: str  # our component's name in fmus.registry, or the FMU file's model name
     path: Path  # the FMU file (ours: built and cached; another tool's: as the scene names it)
     model: ModelInfo  # everything the orchestrator knows of the FMU, read from the file
     parameters: dict[str, Any]  # SI values (int for Integer, bool for Boolean)
@@ -68,13 +71,28 @@ class Connection:
     target: tuple[str, str]  # (instance, input variable)
 
 
+#: What each master's step key sets (its message when the scene gives none).
+STEP_MEANING = {
+    "step": "macro step, e.g. '0.1 ms'",
+    "first_step": "first step (and the step after a switch), e.g. '1 us'",
+}
+
+
 @dataclass(frozen=True)
 class MasterSpec:
     algorithm: str
+    # The fixed macro step: master.step, else the first step the scene gives (what a
+    # fixed-step master, an exported archive's base step and crosscheck step at).
     step: float
     order: tuple[str, ...]
     options: dict[str, Any] = field(default_factory=dict)  # as the scene wrote them (SI)
     settings: MasterSettings | None = None  # the algorithm's, defaults filled in
+
+    @property
+    def own_step(self) -> tuple[str, float]:
+        """The step key this master reads (step or first_step) and the step it takes."""
+        key = step_key(self.algorithm)
+        return key, getattr(self.settings, key, self.step)
 
 
 @dataclass(frozen=True)
@@ -126,8 +144,8 @@ class Scene:
     record_every: int
     output_dir: Path
     headline: dict[str, HeadlineSpec]
-    analysis: str | None
-    analysis_options: dict[str, Any]
+    family: str | None  # [report] family: the scene family whose analysis and plot run
+    report_options: dict[str, Any]  # [report.options], read by the family and the reference
     reference: str | None = None
     stop_when: StopCondition | None = None
     error_bound: float = math.inf  # the error against the reference the scene claims
@@ -320,8 +338,8 @@ class _Loader:
             self.table(raw.get("output", {}), "output"), fmus, name
         )
         report = self.table(raw.get("report", {}), "report")
-        headline, analysis, options, reference, error_bound = self.report(report, fmus)
-        self.report_needs(headline, analysis, reference, options, fmus, record)
+        headline, family_name, options, reference, error_bound = self.report(report, fmus)
+        self.report_needs(headline, family_name, reference, options, fmus, record)
         sweep = self.sweep(raw["sweep"], fmus) if "sweep" in raw else None
         study = self.study(raw["study"], fmus) if "study" in raw else None
         return Scene(
@@ -337,8 +355,8 @@ class _Loader:
             record_every=every,
             output_dir=out_dir,
             headline=headline,
-            analysis=analysis,
-            analysis_options=options,
+            family=family_name,
+            report_options=options,
             reference=reference,
             stop_when=stop_when,
             error_bound=error_bound,
@@ -531,7 +549,7 @@ class _Loader:
                 v.name for v in variables.values() if not causality or v.causality == causality
             ]
             kind = f"{causality} " if causality else ""
-            owner = f"{instance!r} ({fmus[instance].fmu})"
+            owner = f"{instance!r} ({fmus[instance].fmu_name})"
             raise self.fail(key, f"{owner} has no {kind}variable {var!r}; expected one of {wanted}")
         return instance, var
 
@@ -614,20 +632,29 @@ class _Loader:
             )
 
     def master(self, node: dict[str, Any], fmus: dict[str, FmuSpec], duration: float) -> MasterSpec:
-        self.check_keys(node, "master", {*COMMON_KEYS, *SETTING_KINDS})
-        for k in ("algorithm", "step"):
-            if k not in node:
-                raise self.fail(f"master.{k}", "missing")
+        self.check_keys(node, "master", {*COMMON_KEYS, *STEP_KEYS, *SETTING_KINDS})
+        if "algorithm" not in node:
+            raise self.fail("master.algorithm", "missing")
         algorithm = self.string(node, "algorithm", "master.algorithm")
         if algorithm not in ALGORITHMS:
             raise self.fail(
                 "master.algorithm", f"unknown {algorithm!r}; expected one of {list(ALGORITHMS)}"
             )
-        step = self.quantity(node["step"], "master.step", "s")
-        if not step > 0.0:
-            raise self.fail("master.step", f"must be positive, got {step} s")
-        if step > duration:
-            raise self.fail("master.step", f"{step} s is longer than the run ({duration} s)")
+        steps = {}
+        for k in STEP_KEYS:
+            if k in node:
+                steps[k] = value = self.quantity(node[k], f"master.{k}", "s")
+                if not value > 0.0:
+                    raise self.fail(f"master.{k}", f"must be positive, got {value} s")
+                if value > duration:
+                    raise self.fail(
+                        f"master.{k}", f"{value} s is longer than the run ({duration} s)"
+                    )
+        own = step_key(algorithm)
+        if not steps:
+            raise self.fail(f"master.{own}", f"missing; expected the {STEP_MEANING[own]}")
+        used = own if own in steps else next(iter(steps))  # another master's key is lent
+        step, used_key = steps[used], f"master.{used}"
         order = node.get("order", list(fmus))
         if not (
             isinstance(order, list)
@@ -643,19 +670,20 @@ class _Loader:
         largest = getattr(settings, "max_step", None)  # a master that varies its step
         if largest is None and duration / step > MAX_STEPS and not self.force:
             raise self.fail(
-                "master.step",
+                used_key,
                 f"{step:g} s over {duration:g} s is {duration / step:.3g} macro steps, more "
                 f"than the limit {MAX_STEPS:.0e}: the run would not finish (--force to run it)",
             )
         if largest is not None:
             if duration / largest > MAX_STEPS and not self.force:
                 raise self.fail(
-                    "master.max_step" if "max_step" in options else "master.step",
+                    "master.max_step" if "max_step" in options else used_key,
                     f"steps of at most {largest:g} s over {duration:g} s are at least "
                     f"{duration / largest:.3g} macro steps, more than the limit "
                     f"{MAX_STEPS:.0e}: the run would not finish (--force to run it)",
                 )
-        return MasterSpec(algorithm, step, tuple(order), options, settings)
+        fixed_step = steps.get(FixedStepSettings.STEP_KEY, step)
+        return MasterSpec(algorithm, fixed_step, tuple(order), options, settings)
 
     def output(self, node: dict[str, Any], fmus: dict[str, FmuSpec], name: str):
         self.check_keys(node, "output", {"directory", "record", "every"})
@@ -690,8 +718,14 @@ class _Loader:
         return record, every, Path(directory)
 
     def report(self, node: dict[str, Any], fmus: dict[str, FmuSpec]):
+        if "analysis" in node:
+            raise self.fail(
+                "report.analysis",
+                f"renamed: the scene family whose analysis and plot run is report.family "
+                f"(family = {node['analysis']!r})",
+            )
         self.check_keys(
-            node, "report", {"headline", "analysis", "options", "reference", "error_bound"}
+            node, "report", {"headline", "family", "options", "reference", "error_bound"}
         )
         headline: dict[str, HeadlineSpec] = {}
         for hname, entry in self.table(node.get("headline", {}), "report.headline").items():
@@ -708,11 +742,12 @@ class _Loader:
                 )
             unit = fmus[signal[0]].model.variables[signal[1]].unit or "1"
             headline[hname] = HeadlineSpec(signal, reduce, unit)
-        analysis = node.get("analysis")
-        if analysis is not None:
-            if not isinstance(analysis, str) or analysis not in ANALYSES:
+        family_name = node.get("family")
+        if family_name is not None:
+            if not isinstance(family_name, str) or family_name not in ANALYSES:
                 raise self.fail(
-                    "report.analysis", f"unknown {analysis!r}; expected one of {sorted(ANALYSES)}"
+                    "report.family",
+                    f"unknown {family_name!r}; expected one of {sorted(ANALYSES)}",
                 )
         options = self.table(node.get("options", {}), "report.options")
         reference = node.get("reference")
@@ -725,12 +760,12 @@ class _Loader:
         bound = node.get("error_bound", math.inf)
         if isinstance(bound, bool) or not isinstance(bound, int | float) or not bound > 0:
             raise self.fail("report.error_bound", f"expected a positive number, got {bound!r}")
-        return headline, analysis, dict(options), reference, float(bound)
+        return headline, family_name, dict(options), reference, float(bound)
 
     def report_needs(
         self,
         headline: dict[str, HeadlineSpec],
-        analysis: str | None,
+        family_name: str | None,
         reference: str | None,
         options: dict[str, Any],
         fmus: dict[str, FmuSpec],
@@ -744,7 +779,7 @@ class _Loader:
                     f"report.headline.{hname}.signal",
                     f"{'.'.join(spec.signal)} is not recorded; add it to output.record",
                 )
-        users = [n for n in dict.fromkeys((analysis, reference)) if n is not None]
+        users = [n for n in dict.fromkeys((family_name, reference)) if n is not None]
         needs = [family(n).needs for n in users]
         known = sorted({o.name for need in needs for o in need.options})
         for key in options:
@@ -752,7 +787,7 @@ class _Loader:
                 if not users:
                     raise self.fail(
                         f"report.options.{key}",
-                        "options are read by report.analysis or report.reference; none named",
+                        "options are read by report.family or report.reference; none named",
                     )
                 raise self.fail(
                     f"report.options.{key}",
@@ -762,14 +797,14 @@ class _Loader:
             for option in need.options:
                 if option.name in options:
                     self.report_option(option, options[option.name], fmus)
-        if analysis is None:
+        if family_name is None:
             return
-        need = family(analysis).needs
+        need = family(family_name).needs
         missing = need.missing_signals(fmus, options, recorded)
         if missing:
             raise self.fail(
                 "output.record",
-                f"analysis {analysis!r} needs {', '.join(missing)} recorded; add "
+                f"the analysis of {family_name!r} needs {', '.join(missing)} recorded; add "
                 f"{'it' if len(missing) == 1 else 'them'} to output.record",
             )
 
@@ -846,7 +881,7 @@ class _Loader:
                 var = fmus[instance].model.variables[shorthand[0]]
                 return "s" if shorthand[1] == "step" else var.unit or "1"
             if var is None or var.causality != causality:
-                raise self.fail(key, f"{fmus[instance].fmu} has no {causality} {name!r}")
+                raise self.fail(key, f"{fmus[instance].fmu_name} has no {causality} {name!r}")
             return var.unit or "1"
         if len(parts) == 2 and parts[0] == "parameters":
             targets = self.key_variables(dotted, fmus)

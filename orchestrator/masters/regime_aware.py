@@ -25,9 +25,9 @@ be rolled back.  A trial step is accepted when
 
 After a switch the master iterates the exchange at that instant to a fixed point (so an
 impact's momentum exchange reaches the other FMU before anything moves), records the left
-and right values, logs the switch, and restarts with a short step (``master.step``; into
-regimes where every accepted step so far had zero coupling error, a fraction of the step
-proposed there last).  A guard stops runs that keep switching at one instant (chattering /
+and right values, logs the switch, and restarts with a short step (``master.first_step``;
+into regimes where every accepted step so far had zero coupling error, a fraction of the
+step proposed there last).  A guard stops runs that keep switching at one instant (chattering /
 Zeno) with a diagnosis.
 """
 
@@ -46,7 +46,7 @@ from orchestrator.system import CoupledSystem
 
 
 @dataclass
-class _Snapshot:
+class _Readings:
     """Everything read from the FMUs at one instant."""
 
     values: list[list[float]]
@@ -123,7 +123,7 @@ class RegimeAwareMaster:
         # input would be wrong at first order, unseen by the error test, so its inputs stay
         # at their step-start values and their change over the step is the error (first
         # order, as with input_hold = "start").
-        held, blind = set(), set()
+        held, unannotated = set(), set()
         self.held_inputs: list[list[tuple[tuple[int, int], bool]]] = [[] for _ in self.names]
         for c, src in zip(system.connections, system.connection_sources, strict=True):
             if src is None:
@@ -131,13 +131,13 @@ class RegimeAwareMaster:
             model = system.models[system.index[c.target[0]]]
             sampled = c.target[1] in model.sampled
             if not model.annotated:
-                blind.add(src)
+                unannotated.add(src)
             elif not sampled:
                 held.add(src)
             averaged = model.annotated and not sampled
             self.held_inputs[system.index[c.target[0]]].append((src, averaged))
-        self.signals = sorted(held | blind)  # start hold: every held signal's change
-        self.blind = sorted(blind)
+        self.signals = sorted(held | unannotated)  # start hold: every held signal's change
+        self.unannotated = sorted(unannotated)
         self.scale = {s: 0.0 for s in self.signals}
         black_boxes = sorted(
             {c.target[0] for c in system.connections}
@@ -162,9 +162,9 @@ class RegimeAwareMaster:
         self.zero_error_step: dict[tuple[int | None, ...], float] = {}
 
     # -- helpers ----------------------------------------------------------------------
-    def snapshot(self) -> _Snapshot:
+    def readings(self) -> _Readings:
         s = self.system
-        return _Snapshot(
+        return _Readings(
             [list(v) for v in s.values],
             [list(v) for v in s.ints],
             s.regimes(),
@@ -206,7 +206,7 @@ class RegimeAwareMaster:
         self,
         t: float,
         h: float,
-        before: _Snapshot,
+        before: _Readings,
         state: list[Any],
         predicted: list[list[float]],
         at: _Predictor | None,
@@ -257,7 +257,7 @@ class RegimeAwareMaster:
             system.feed(i)
         system.read_all()
 
-    def switch_time(self, t: float, h: float, before: _Snapshot) -> _Switch:
+    def switch_time(self, t: float, h: float, before: _Readings) -> _Switch:
         """Earliest switching instant inside (t, t+h], or None if nothing switched.
 
         An FMU that reports its internal event time gives it exactly; an indicator that
@@ -294,16 +294,16 @@ class RegimeAwareMaster:
                 best = t + 0.5 * h
         return _Switch(best, best is not None and best == reported)
 
-    def step_ratio(self, before: _Snapshot, correction: _Correction | None) -> _Estimate:
+    def step_ratio(self, before: _Readings, correction: _Correction | None) -> _Estimate:
         """Error estimate of the step just taken, relative to the tolerance (<= 1 accepts):
         the corrector's (second order), or the change of the signals held at the step start
         (first order) where that is larger."""
         if not self.cfg.midpoint:
             return _Estimate(self.error_ratio(before, self.signals), True)
-        blind = self.error_ratio(before, self.blind) if self.blind else 0.0
-        return _Estimate(max(correction.ratio, blind), blind > correction.ratio)
+        unannotated = self.error_ratio(before, self.unannotated) if self.unannotated else 0.0
+        return _Estimate(max(correction.ratio, unannotated), unannotated > correction.ratio)
 
-    def error_ratio(self, before: _Snapshot, signals: list[tuple[int, int]]) -> float:
+    def error_ratio(self, before: _Readings, signals: list[tuple[int, int]]) -> float:
         """Held-input error estimate relative to the tolerance: the signals' change."""
         values = self.system.values
         worst = 0.0
@@ -330,7 +330,7 @@ class RegimeAwareMaster:
             f" in {self.cfg.max_iterations} rounds"
         )
 
-    def _note_changes(self, before: _Snapshot) -> None:
+    def _note_changes(self, before: _Readings) -> None:
         """Remember the last regime change since ``before`` (the chattering diagnosis)."""
         changes = regime_changes(self.system, before.regimes, self.system.regimes())
         if changes:
@@ -345,7 +345,7 @@ class RegimeAwareMaster:
         # Ends on an input signal's breakpoint; its hold error within the tolerance.
         h = system.signals.clip(t, min(self.h, stop - t), cfg.tolerance)
         state = system.get_state()
-        before = self.snapshot()  # consistent: every trial and settle ends refreshed
+        before = self.readings()  # consistent: every trial and settle ends refreshed
         try:
             accepted = self._attempt(t, h, before, state)
             h, te = accepted.h, accepted.switch_at
@@ -398,12 +398,12 @@ class RegimeAwareMaster:
             self.zero_error_step.pop(regimes, None)
 
     def _restart_step(self, regimes: tuple[int | None, ...]) -> float:
-        """The first step after a switch into ``regimes``: master.step, or where the
+        """The first step after a switch into ``regimes``: master.first_step, or where the
         coupling error has been exactly zero, a fraction of the step proposed there."""
         remembered = self.zero_error_step.get(regimes, 0.0) * self.control.zero_error_restart
         return max(self.cfg.first_step, remembered)  # remembered steps are <= max_step
 
-    def _attempt(self, t: float, h: float, before: _Snapshot, state: list[Any]) -> _Accepted:
+    def _attempt(self, t: float, h: float, before: _Readings, state: list[Any]) -> _Accepted:
         """Trial steps from t until one is accepted.
 
         A signal that jumps without a reported event (its change does not shrink with the
@@ -471,7 +471,7 @@ class RegimeAwareMaster:
         h: float,
         te: float,
         located: bool,
-        before: _Snapshot,
+        before: _Readings,
         state: list[Any],
         predictor: _Predictor,
     ) -> tuple[float | None, bool, list[float] | None, _Correction | None]:
@@ -508,7 +508,7 @@ class RegimeAwareMaster:
         return self.instant if located else self.cfg.event_tolerance
 
     def _left_values(
-        self, t: float, accepted: _Accepted, state: list[Any], before: _Snapshot
+        self, t: float, accepted: _Accepted, state: list[Any], before: _Readings
     ) -> list[float] | None:
         """Recorded values just before the switch the accepted step ends on (then the step
         is retaken to its end)."""
@@ -532,13 +532,13 @@ class RegimeAwareMaster:
             self.trial(t, h)
         return row
 
-    def _restore(self, state: list[Any], before: _Snapshot) -> None:
+    def _restore(self, state: list[Any], before: _Readings) -> None:
         """Back to the step start (a rollback, not a rejection: the corrector's retake);
         the values there are those read then."""
         self.system.set_state(state, (before.values, before.ints))
         self.stats.rollbacks += 1
 
-    def _rollback(self, state: list[Any], before: _Snapshot) -> None:
+    def _rollback(self, state: list[Any], before: _Readings) -> None:
         """Back to the step start after a rejected trial."""
         self._restore(state, before)
         self.stats.rejections += 1

@@ -16,15 +16,17 @@ from orchestrator.system import CoupledSystem
 def regime_aware(system: CoupledSystem, scene: Scene, stats: StepStats) -> Master:
     """The regime-aware master of ``scene``; fixed-step Jacobi where an FMU cannot save and
     restore its state."""
-    blind = [n for n, m in zip(system.names, system.models, strict=True) if not m.can_get_set_state]
-    if blind:
+    cannot_save = [
+        n for n, m in zip(system.names, system.models, strict=True) if not m.can_get_set_state
+    ]
+    if cannot_save:
         # Without rollback no trial can be taken back: say what is given up, and couple
         # the way every tool can.
         stats.extra.setdefault("warnings", []).append(
-            f"FMU {', '.join(map(repr, blind))} cannot save and restore its state "
+            f"FMU {', '.join(map(repr, cannot_save))} cannot save and restore its state "
             "(canGetAndSetFMUstate is false), which the regime-aware master needs to reject "
-            "steps and to land on switches: it gives both up and runs fixed-step Jacobi at "
-            f"master.step = {scene.master.step:g} s (no error control, switches seen only "
+            "steps and to land on switches: it gives both up and runs fixed-step Jacobi in "
+            f"steps of {scene.master.step:g} s (no error control, switches seen only "
             "at communication points)"
         )
         return fixed_step_master(system, scene, stats, scene.master.step, sequential=False)

@@ -29,8 +29,9 @@ ends its step at its first event and says where in ``t_reached``; such FMUs are 
 first (those giving step means before their receivers), each to where the earliest so far
 stopped, and the others once to that instant: landing on a switch costs one doStep of
 each FMU, none retaken.  When one stops before an instant the ones before it were stepped
-to, those are stepped again to it (it stays where it stopped, with the inputs it had).  A switch that only an indicator or a reported event
-time of another FMU shows is located and landed on as in the midpoint master.
+to, those are stepped again to it (it stays where it stopped, with the inputs it had).
+A switch that only an indicator or a reported event time of another FMU shows is located
+and landed on as in the midpoint master.
 """
 
 from __future__ import annotations
@@ -39,7 +40,7 @@ from typing import Any
 
 from orchestrator.errors import RunError
 from orchestrator.masters.macro_step import MacroStep
-from orchestrator.masters.regime_aware import RegimeAwareMaster, _Snapshot
+from orchestrator.masters.regime_aware import RegimeAwareMaster, _Readings
 from orchestrator.observers import regime_changes
 
 #: Name of the Integer input by which an FMU offers to end a step at its first event, and
@@ -53,15 +54,15 @@ MEAN_SUFFIX = "_mean"
 
 
 #: After a switch, restart at this fraction of the step proposed last in the regimes
-#: entered (M739 at 1e-3: 3208 steps against 3493 restarting at master.step; at 0.5 and 1
-#: fewer steps but a larger error for the same time).
+#: entered (M739 at 1e-3: 3208 steps against 3493 restarting at master.first_step; at 0.5
+#: and 1 fewer steps but a larger error for the same time).
 RESTART = 0.25
 #: Previous points of the extrapolation: 1, linear (2, quadratic, took 26 % fewer steps on
 #: M739 at 1e-3 but tripled its turns error, 4.5e-4 against 1.4e-4).
 ORDER = 1
 #: Passes over one step when FMUs that end early stop before one another.
 MAX_ROUNDS = 4
-#: The step after an accepted one grows at most by StepControl.max_growth, and by this
+#: The step after an accepted one grows at most by MasterStepControl.max_growth, and by this
 #: factor less than the estimate allows (M739 at 1e-3: 152 rejected passes against 544).
 GROWTH_SAFETY = 0.8
 #: A copied source's travel in a step is taken as at least this fraction of its travel at
@@ -235,9 +236,9 @@ class SinglePassMaster(RegimeAwareMaster):
 
     # -- one pass -----------------------------------------------------------------------
     def feeds_for(
-        self, h: float, before: _Snapshot, done: set[int] = frozenset()
+        self, h: float, before: _Readings, done: set[int] = frozenset()
     ) -> list[list[float]]:
-        """Every FMU's Real inputs for a step h from the snapshot: held signals at the mean
+        """Every FMU's Real inputs for a step h from ``before``: held signals at the mean
         of their extrapolation, sampled ones at their start values, and from a source
         already stepped over this very step (``done``) that gives its step mean, that."""
         start, now = before.values, self.system.values
@@ -256,7 +257,7 @@ class SinglePassMaster(RegimeAwareMaster):
             feeds.append(row)
         return feeds
 
-    def one_pass(self, t: float, h: float, before: _Snapshot, state: list[Any]) -> float:
+    def one_pass(self, t: float, h: float, before: _Readings, state: list[Any]) -> float:
         """Step every FMU once from t, those that end at their first event first (the
         ones that give step means before their receivers), each to where the earliest so
         far stopped, then the others there.  When one stops before an instant the ones
@@ -306,7 +307,7 @@ class SinglePassMaster(RegimeAwareMaster):
         self.pass_do_steps = self.stats.do_steps - do_steps
         return h_end
 
-    def estimate(self, h: float, before: _Snapshot) -> float:
+    def estimate(self, h: float, before: _Readings) -> float:
         """Error ratio of the step just taken: the extrapolated mean against the
         trapezoidal mean of each held signal's actual start and end values.  An FMU that
         ended its step at its own event has its outputs of after the event there (they
@@ -345,9 +346,9 @@ class SinglePassMaster(RegimeAwareMaster):
                     (vs, (vj, vk)) = speed
                     miss = max(miss, abs(end[vj][vk] - now[vs[0]][vs[1]]) * h)
                 worst = max(worst, miss / (tol * travel))
-        blind = self.error_ratio(before, self.blind) if self.blind else 0.0
-        self.first_order = blind > worst or not ex.second_order
-        return max(worst, blind)
+        unannotated = self.error_ratio(before, self.unannotated) if self.unannotated else 0.0
+        self.first_order = unannotated > worst or not ex.second_order
+        return max(worst, unannotated)
 
     # -- one macro step (the execution loop calls it) ---------------------------------
     def step(self, t: float, stop: float) -> MacroStep:
@@ -357,7 +358,7 @@ class SinglePassMaster(RegimeAwareMaster):
         # Ends on an input signal's breakpoint; its hold error within the tolerance.
         h = system.signals.clip(t, min(self.h, stop - t), cfg.tolerance)
         state = system.get_state()
-        before = self.snapshot()
+        before = self.readings()
         self.extrapolation.prepare(t, before.values)
         do_steps = stats.do_steps
         try:
@@ -427,12 +428,12 @@ class SinglePassMaster(RegimeAwareMaster):
 
     def _restart_step(self, regimes: tuple[int | None, ...]) -> float:
         """After a switch: a fraction of the step proposed last in the regimes entered (a
-        too long one costs one pass), at least master.step."""
+        too long one costs one pass), at least master.first_step."""
         remembered = self.last_step.get(regimes, 0.0) * RESTART
         return max(self.cfg.first_step, remembered)
 
     def _attempt(
-        self, t: float, h: float, before: _Snapshot, state: list[Any]
+        self, t: float, h: float, before: _Readings, state: list[Any]
     ) -> tuple[float, float | None, float]:
         """Passes from t until one is accepted: (h, switch time or None, error ratio)."""
         cfg, control = self.cfg, self.control

@@ -17,7 +17,7 @@ from pathlib import Path
 from orchestrator.lazy import LazyRegistry
 from orchestrator.scenes.family import SceneFamily, SharedParameter
 
-#: Family names, as ``[report] analysis`` / ``reference`` name them.
+#: Family names, as ``[report] family`` / ``reference`` name them.
 FAMILY_NAMES: tuple[str, ...] = tuple(
     sorted(m.name for m in pkgutil.iter_modules([str(Path(__file__).parent)]) if m.ispkg)
 )

@@ -104,7 +104,7 @@ class SharedParameter:
 
 @dataclass(frozen=True)
 class SceneFamily:
-    """One family of scenes (``[report] analysis`` / ``reference`` name it): what it reads,
+    """One family of scenes (``[report] family`` / ``reference`` name it): what it reads,
     and where its analysis, plot and reference live ("module:function", imported when used).
 
     analysis: (scene, header, data, options) -> {name: Quantity}

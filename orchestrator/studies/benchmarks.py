@@ -281,7 +281,7 @@ def _first_within(scene_file: str, quantity: str, truth: float | None, budget: f
     for tol in SINGLE_PASS_TOLERANCES:
         overrides = {**SINGLE_PASS, "master.tolerance": tol}
         if scene_file.startswith("press_feed"):
-            overrides["master.step"] = 1e-6
+            overrides["master.first_step"] = 1e-6
         scene = load_scene(SCENARIOS / scene_file, overrides)
         result = run_scene(
             scene,

@@ -61,7 +61,8 @@ def limit_rows(result: StudyResult) -> list[tuple[str, str, st.Violation, int]]:
 def write_markdown(result: StudyResult, path: Path) -> None:
     spec, scene = result.spec, result.scene
     m = scene.master
-    master = f"{m.algorithm}, step {m.step:g} s" + "".join(
+    key, step = m.own_step
+    master = f"{m.algorithm}, {key.replace('_', ' ')} {step:g} s" + "".join(
         f", {k} {v:g}" for k, v in m.options.items() if k in ("tolerance",)
     )
     counts = Counter(s.status for s in result.samples)

@@ -8,7 +8,7 @@ import pytest
 
 from components.base import ComponentError
 from components.event_integration import (
-    StepControl,
+    IntegrationStepControl,
     _dp5_step,
     advance,
     dense_state,
@@ -53,7 +53,7 @@ class BouncingBall:
 def test_error_follows_the_tolerance() -> None:
     errors = []
     for rtol in (1e-6, 1e-8, 1e-10):
-        done = advance(Oscillator(), [1.0, 0.0], 10.0, StepControl(rtol, (1.0, 1.0)))
+        done = advance(Oscillator(), [1.0, 0.0], 10.0, IntegrationStepControl(rtol, (1.0, 1.0)))
         errors.append(abs(done.y[0] - math.cos(10.0)))
         assert errors[-1] < 100 * rtol
     # Each hundredfold tightening buys about a hundredfold (the global error is ~ rtol).
@@ -62,7 +62,7 @@ def test_error_follows_the_tolerance() -> None:
 
 def test_events_located_to_the_time_tolerance() -> None:
     model = Oscillator()
-    done = advance(model, [1.0, 0.0], 10.0, StepControl(1e-10, (1.0, 1.0)))
+    done = advance(model, [1.0, 0.0], 10.0, IntegrationStepControl(1e-10, (1.0, 1.0)))
     exact = [2.0 * math.pi / 3.0, 2.0 * math.pi / 3.0 + 2.0 * math.pi]
     assert done.events == 2
     assert model.events == pytest.approx(exact, abs=1e-9)
@@ -74,7 +74,9 @@ def test_dense_output_is_fifth_order_locally() -> None:
     errs = []
     for h in (0.2, 0.1, 0.05):
         y = [1.0, 0.0]
-        step = _dp5_step(model.deriv, y, model.deriv(y), h, StepControl(1e-6, (1.0, 1.0)))
+        step = _dp5_step(
+            model.deriv, y, model.deriv(y), h, IntegrationStepControl(1e-6, (1.0, 1.0))
+        )
         errs.append(abs(dense_state(step.dense, 0.37)[0] - math.cos(0.37 * h)))
     assert errs[0] / errs[1] > 30 and errs[1] / errs[2] > 30
 
@@ -83,7 +85,7 @@ def test_bounces_match_the_closed_form() -> None:
     ball = BouncingBall()
     # A parabola has no error to control, so the steps would grow over a whole flight and
     # never see a sign change at a step end: h_max bounds that.
-    advance(ball, [1.0, 0.0], 2.0, StepControl(1e-10, (1.0, 1.0), 0.05), max_events=50)
+    advance(ball, [1.0, 0.0], 2.0, IntegrationStepControl(1e-10, (1.0, 1.0), 0.05), max_events=50)
     t1 = math.sqrt(2.0 / 9.81)
     expected = [t1 + sum(2.0 * 0.8**k * t1 for k in range(1, n + 1)) for n in range(3)]
     assert ball.bounces[:3] == pytest.approx(expected, rel=1e-9)
@@ -91,7 +93,7 @@ def test_bounces_match_the_closed_form() -> None:
 
 def test_step_size_carries_over_and_output_is_observed() -> None:
     seen: list[tuple[float, float]] = []
-    control = StepControl(1e-8, (1.0, 1.0))
+    control = IntegrationStepControl(1e-8, (1.0, 1.0))
     first = advance(Oscillator(), [1.0, 0.0], 1.0, control)
     again = advance(
         Oscillator(),
@@ -109,7 +111,7 @@ def test_step_size_carries_over_and_output_is_observed() -> None:
 def test_bad_controls_are_refused() -> None:
     for rtol, h_max in ((0.0, 1.0), (2.0, 1.0), (1e-6, 0.0), (math.nan, 1.0)):
         with pytest.raises(ComponentError):
-            StepControl(rtol, (1.0,), h_max)
+            IntegrationStepControl(rtol, (1.0,), h_max)
 
 
 class TwoClocks:
@@ -132,7 +134,7 @@ class TwoClocks:
 
 def test_two_indicators_crossing_at_one_instant_both_fire() -> None:
     model = TwoClocks()
-    done = advance(model, [0.0], 3.0, StepControl(1e-8, (1.0,)), tol_t=1e-13)
+    done = advance(model, [0.0], 3.0, IntegrationStepControl(1e-8, (1.0,)), tol_t=1e-13)
     assert [i for i, _ in model.fired] == [0, 1, 2]  # index order at one instant
     (_, t0), (_, t1), (_, t2) = model.fired
     assert t0 == t1 == pytest.approx(1.0, abs=1e-12)
@@ -170,7 +172,7 @@ class StopOnTheMark:
 
 def test_an_event_that_leaves_another_indicator_past_zero_fires_it() -> None:
     model = StopOnTheMark()
-    done = advance(model, [0.0], 10.0, StepControl(1e-8, (1.0,)), tol_t=1e-13)
+    done = advance(model, [0.0], 10.0, IntegrationStepControl(1e-8, (1.0,)), tol_t=1e-13)
     assert [i for i, _ in model.fired] == [0, 0, 1]
     assert [t for _, t in model.fired] == pytest.approx([1.0, 2.0, 2.0], abs=1e-12)
     assert model.halted
@@ -181,7 +183,7 @@ def test_an_indicator_negative_before_the_step_does_not_fire() -> None:
     """Only indicators armed (>= 0) at the step start can fire at an event's instant."""
     model = StopOnTheMark()
     model.stop_at = -1.0  # behind the wheel from the start: never armed
-    advance(model, [0.0], 3.5, StepControl(1e-8, (1.0,)), tol_t=1e-13)
+    advance(model, [0.0], 3.5, IntegrationStepControl(1e-8, (1.0,)), tol_t=1e-13)
     assert [i for i, _ in model.fired] == [0, 0, 0]
 
 
@@ -192,7 +194,7 @@ def test_an_early_return_still_fires_every_event_of_its_instant() -> None:
 
     model = TwoClocks()
     wrapper = UntilFirstEvent(model, 0.0)
-    done = advance(wrapper, [0.0], 3.0, StepControl(1e-8, (1.0,)), tol_t=1e-13)
+    done = advance(wrapper, [0.0], 3.0, IntegrationStepControl(1e-8, (1.0,)), tol_t=1e-13)
     assert [i for i, _ in model.fired] == [0, 1]  # both of t = 1, not the one at t = 2
     assert done.y[0] == pytest.approx(1.0, abs=1e-12)
     assert wrapper.stopped_at == pytest.approx(1.0, abs=1e-12)

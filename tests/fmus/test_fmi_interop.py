@@ -34,6 +34,7 @@ B = {"J": 1e-4, "k": 2.0, "d": 2e-3, "phi0": 0.0, "w0": 0.0, "n_sub": 10}
 
 
 def foreign_scene(fmu: str, algorithm: str = "jacobi", step: str = "1 ms") -> str:
+    step_key = "first_step" if algorithm == "regime-aware" else "step"
     return f"""
 [scene]
 name = "foreign"
@@ -62,7 +63,7 @@ to = "c.flange.w"
 
 [master]
 algorithm = "{algorithm}"
-step = "{step}"
+{step_key} = "{step}"
 
 [output]
 record = ["a.phi", "a.w", "c.body.phi", "c.body.w", "c.flange.tau"]
@@ -133,7 +134,7 @@ def test_dotted_names_work_in_overrides(tmp_path, foreign) -> None:
 @needs_cc
 def test_regime_aware_master_steps_a_black_box_with_rollback(tmp_path, foreign) -> None:
     path = write_scene(tmp_path, foreign_scene(str(foreign / "TorsionBody.fmu"), "regime-aware"))
-    scene = load_scene(path, {"master.tolerance": 1e-2, "master.step": "0.1 ms"})
+    scene = load_scene(path, {"master.tolerance": 1e-2, "master.first_step": "0.1 ms"})
     r = run_scene(scene, output_dir=tmp_path / "run", show_progress=False, plots=False)
     assert r.status == "completed", r.message
     assert r.stats.rollbacks > 0

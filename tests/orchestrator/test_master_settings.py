@@ -13,8 +13,8 @@ from orchestrator.master_settings import (
     SETTING_KINDS,
     SETTINGS,
     FixedStepSettings,
+    MasterStepControl,
     RegimeAwareSettings,
-    StepControl,
 )
 from orchestrator.masters import MASTERS, TOLERANCE_MASTERS
 from orchestrator.scenario import load_scene
@@ -41,14 +41,14 @@ def test_scene_settings_are_typed_with_defaults_filled_in() -> None:
     assert s.event_tolerance == 1e-10 and s.min_step == 1e-14
     assert s.first_step == scene.master.step
     assert s.max_step == min(100.0 * scene.master.step, scene.stop - scene.start)
-    assert s.midpoint and s.control == StepControl()
+    assert s.midpoint and s.control == MasterStepControl()
     # A setting another master uses is accepted and ignored.
     jacobi = load_scene(TWO, {"master.algorithm": "jacobi", "master.tolerance": 1e-3})
     assert jacobi.master.settings == FixedStepSettings(jacobi.master.step)
 
 
 def test_step_control_factors() -> None:
-    c = StepControl()
+    c = MasterStepControl()
     assert c.grow(0.0, False) == c.max_growth
     assert c.grow(1e-9, True) == c.max_growth
     assert c.shrink(1e9, False) == c.max_shrink
@@ -73,3 +73,43 @@ def test_bad_settings_name_the_key(overrides: dict, key: str, fragment: str) -> 
     with pytest.raises(ScenarioError) as info:
         load_scene(TWO, {"master.algorithm": "regime-aware", **overrides})
     assert f"[{key}]" in str(info.value) and fragment in str(info.value)
+
+
+M739 = SCENARIOS / "m739.toml"
+
+
+def test_each_master_reads_its_own_step_key() -> None:
+    """master.step is the fixed-step masters' macro step, master.first_step the
+    regime-aware master's first step; a scene that gives only one lends it to the other."""
+    m739 = load_scene(M739)  # regime-aware, first_step = "1 us"
+    assert m739.master.settings.first_step == 1e-6 and m739.master.step == 1e-6
+    jacobi = load_scene(M739, {"master.algorithm": "jacobi"})
+    assert jacobi.master.settings == FixedStepSettings(1e-6)
+    both = {"master.step": 5e-6}
+    assert load_scene(M739, both).master.settings.first_step == 1e-6
+    assert load_scene(M739, both).master.step == 5e-6
+    assert load_scene(M739, {**both, "master.algorithm": "jacobi"}).master.settings.step == 5e-6
+    two = load_scene(TWO, {"master.algorithm": "regime-aware"})  # jacobi, step = "0.1 ms"
+    assert two.master.settings.first_step == two.master.step == 1e-4
+
+
+@pytest.mark.parametrize(
+    ("overrides", "key", "fragment"),
+    [
+        ({"master.first_step": "-1 us"}, "master.first_step", "must be positive"),
+        ({"master.first_step": "1 s"}, "master.first_step", "longer than the run"),
+        ({"master.step": "0 s"}, "master.step", "must be positive"),
+    ],
+)
+def test_bad_steps_name_their_key(overrides: dict, key: str, fragment: str) -> None:
+    with pytest.raises(ScenarioError) as info:
+        load_scene(M739, overrides)
+    assert f"[{key}]" in str(info.value) and fragment in str(info.value)
+
+
+def test_a_missing_step_names_the_masters_own_key(tmp_path: Path) -> None:
+    text = M739.read_text().replace('first_step = "1 us"\n', "")
+    path = tmp_path / "m739.toml"
+    path.write_text(text)
+    with pytest.raises(ScenarioError, match=r"\[master\.first_step\] missing; expected the first"):
+        load_scene(path)

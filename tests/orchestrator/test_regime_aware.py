@@ -157,7 +157,7 @@ inputs = { load_torque = "2 lbf*in" }
 
 [master]
 algorithm = "regime-aware"
-step = "10 us"
+first_step = "10 us"
 event_tolerance = "1e-10 s"
 """
 

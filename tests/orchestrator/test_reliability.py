@@ -214,7 +214,7 @@ def test_option_values_checked_at_load(scene: Path, key: str, value, fragment: s
         ),
         (TWO, {"output.directory": ""}, "output.directory", "expected a directory"),
         (TWO, {"master.step": "1e-12 s"}, "master.step", "--force"),
-        (M739, {"master.step": "1e-15 s"}, "master.step", "--force"),
+        (M739, {"master.first_step": "1e-15 s"}, "master.first_step", "--force"),
         # a shared parameter is stated once: the old per-FMU key names the new one
         (
             M739,

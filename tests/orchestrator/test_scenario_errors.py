@@ -127,3 +127,13 @@ def test_units_convert_once_to_si() -> None:
     assert to_si("160 lbf*in", "N.m") == pytest.approx(18.0775726)
     assert to_si("10 N*m*s/rad", "N.m.s/rad") == pytest.approx(10.0)
     assert to_si(2.5, "kg.m2") == 2.5
+
+
+def test_the_former_report_analysis_key_names_report_family(tmp_path: Path) -> None:
+    text = GOOD + '\n[report]\nanalysis = "m739"\n'
+    expect_error(write(tmp_path, text), "report.analysis", "renamed", "report.family", "'m739'")
+
+
+def test_an_unknown_family_is_refused(tmp_path: Path) -> None:
+    text = GOOD + '\n[report]\nfamily = "m793"\n'
+    expect_error(write(tmp_path, text), "report.family", "unknown 'm793'", "'m739'")

@@ -34,7 +34,11 @@ from orchestrator.scenes.press_feed.report import (
 )
 
 SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
-REGIME_AWARE = {"master.algorithm": "regime-aware", "master.step": "1 us", "master.tolerance": 1e-3}
+REGIME_AWARE = {
+    "master.algorithm": "regime-aware",
+    "master.first_step": "1 us",
+    "master.tolerance": 1e-3,
+}
 GRAZING = ("clutch", "engaged", "overrun")
 
 

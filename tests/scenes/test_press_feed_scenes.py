@@ -109,12 +109,12 @@ def test_scenes_check():
 @pytest.mark.parametrize("name", SCENES)
 def test_scene_loads_only_its_three_fmus(name):
     scene = load_scene(SCENARIOS / name, FIXED_STEP.get(name))
-    assert sorted(spec.fmu for spec in scene.fmus.values()) == [
+    assert sorted(spec.fmu_name for spec in scene.fmus.values()) == [
         "BrakeLoad",
         "CrankCouplerDrive",
         "SpragClutch",
     ]
-    assert scene.analysis == "press_feed" and scene.reference == "press_feed"
+    assert scene.family == "press_feed" and scene.reference == "press_feed"
     assert scene.master.algorithm == "gauss-seidel"
     # ports joined every role: angle and speed of both races in, torque out to both sides
     assert len(scene.connections) == 6

@@ -33,7 +33,7 @@ from orchestrator.studies.stability import run_suite
 SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
 SINGLE_PASS = {"master.algorithm": "regime-aware", "master.input_hold": "extrapolated"}
 #: The press feed's regime-aware settings in tests/scenes/test_press_feed_regime_aware.py.
-PRESS_FEED = {"master.step": "1 us", "master.tolerance": 1e-3}
+PRESS_FEED = {"master.first_step": "1 us", "master.tolerance": 1e-3}
 
 
 def run(tmp_path: Path, fmu_cache: Path, scene: str, reference: bool = True, **overrides):

@@ -107,7 +107,7 @@ _OPTIONS = ("lever", "nominal_period", "load_step")
 
 def lever_scene(scene: Scene) -> LeverScene:
     """The scene's lever: ``[report.options] lever`` or its only DetachedLever instance."""
-    options = scene.analysis_options
+    options = scene.report_options
     unknown = sorted(set(options) - set(_OPTIONS))
     if unknown:
         raise ScenarioError(
@@ -116,12 +116,12 @@ def lever_scene(scene: Scene) -> LeverScene:
     if "lever" in options:
         name = options["lever"]
         if name not in scene.fmus or scene.fmus[name].component != LEVER_FMU:
-            levers = sorted(n for n, s in scene.fmus.items() if s.fmu == LEVER_FMU)
+            levers = sorted(n for n, s in scene.fmus.items() if s.fmu_name == LEVER_FMU)
             raise ScenarioError(
                 scene.path, "report.options.lever", f"expected one of the levers {levers}"
             )
     else:
-        levers = [n for n, s in scene.fmus.items() if s.fmu == LEVER_FMU]
+        levers = [n for n, s in scene.fmus.items() if s.fmu_name == LEVER_FMU]
         if len(levers) != 1:
             raise ScenarioError(
                 scene.path,
@@ -150,10 +150,10 @@ def lever_scene(scene: Scene) -> LeverScene:
 
 
 def _positive_option(scene: Scene, key: str, unit: str) -> float | None:
-    if key not in scene.analysis_options:
+    if key not in scene.report_options:
         return None
     try:
-        value = to_si(scene.analysis_options[key], unit)
+        value = to_si(scene.report_options[key], unit)
     except ValueError as exc:
         raise ScenarioError(scene.path, f"report.options.{key}", str(exc)) from None
     if not value > 0.0:

@@ -23,7 +23,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from components.event_integration import StepControl, advance
+from components.event_integration import IntegrationStepControl, advance
 from components.gear_train import INDEXING_AS_RUN, INDEXING_PHYSICAL, TrainPhysics
 from components.m739_data import LBF, M739, M739Data, rpm_to_rad_s
 from components.verge_escapement import STATE_SCALES, VergeConstants, VergeCore
@@ -184,7 +184,7 @@ def simulate(
         cols["f23"].append(f23)
         cols["pn"].append(pn)
 
-    control = StepControl(tolerance, STATE_SCALES)
+    control = IntegrationStepControl(tolerance, STATE_SCALES)
     h_next = 0.0
     t = 0.0
     sample(t, y)

@@ -26,7 +26,7 @@ from orchestrator.scenes.m739.monolithic import run_m739
 
 def instance_names(scene: Scene) -> tuple[str, str]:
     """(gear train, verge) instances, from [report.options]."""
-    o = scene.analysis_options
+    o = scene.report_options
     return o.get("train", "train"), o.get("verge", "verge")
 
 

@@ -524,7 +524,7 @@ def reference(scene: Scene) -> Reference:
     opts = feed_options(scene)
     res = simulate_feed(opts)
     duration = scene.stop - scene.start
-    headline = reference_quantities(res, fs, duration, scene.analysis_options)
+    headline = reference_quantities(res, fs, duration, scene.report_options)
     s = res.series
     drive = build_drive_model(opts.rpm, fs.linkage(), fs.coupler(), rigid=fs.rigid)
     theta4 = np.array(

@@ -48,8 +48,8 @@ def two_inertias_exact(
 
 def two_inertias_reference(scene: Scene) -> Reference:
     """The closed form as the scene's Reference (instances named in report.options)."""
-    a = scene.analysis_options.get("body_a", "a")
-    b = scene.analysis_options.get("body_b", "b")
+    a = scene.report_options.get("body_a", "a")
+    b = scene.report_options.get("body_b", "b")
     par_a = {v.name: v.start for v in scene.component_class(a).VARIABLES}
     par_b = {v.name: v.start for v in scene.component_class(b).VARIABLES}
     par_a.update(scene.fmus[a].parameters)
