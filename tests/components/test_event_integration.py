@@ -216,4 +216,6 @@ class StuckOnTheSurface:
 
 def test_chattering_names_the_indicator_and_where() -> None:
     with pytest.raises(ComponentError, match=r"chattering: indicators 1, 0\.5 s into the step"):
-        advance(StuckOnTheSurface(), [0.0], 2.0, StepControl(1e-8, (1.0,)), max_events=50)
+        advance(
+            StuckOnTheSurface(), [0.0], 2.0, IntegrationStepControl(1e-8, (1.0,)), max_events=50
+        )
