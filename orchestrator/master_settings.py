@@ -116,12 +116,13 @@ class RegimeAwareSettings:
     max_step: float = setting(None, "s")  # default: 100 first steps, at most the run
     max_iterations: int = setting(10)  # exchange rounds at a switching instant
     max_events_per_step: int = setting(50)  # switches at (nearly) one instant: chattering
-    input_hold: str = setting("midpoint", choices=("start", "midpoint", "extrapolated"))
+    input_hold: str = setting("auto", choices=("auto", "start", "midpoint", "extrapolated"))
     control: MasterStepControl = MasterStepControl()
 
     @property
     def midpoint(self) -> bool:
-        """Corrector with held inputs at their step mean (else held at the step start)."""
+        """Corrector with held inputs at their step mean (else held at the step start);
+        ``"auto"`` is resolved to a scheme before a master is made of these settings."""
         return self.input_hold == "midpoint"
 
     @property

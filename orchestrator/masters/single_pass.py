@@ -166,6 +166,17 @@ def angles_with_speeds(
     ]
 
 
+def judged_by_copies(system: Any) -> bool:
+    """Whether some FMU of the system reports its own copy of a sampled input (the error
+    measure the single pass needs to take long steps; ``input_hold = "auto"``)."""
+    for c, src in zip(system.connections, system.connection_sources, strict=True):
+        model = system.models[system.index[c.target[0]]]
+        if src is not None and c.target[1] in model.sampled:
+            if c.target[1] + OWN_SUFFIX in model.variables:
+                return True
+    return False
+
+
 class SinglePassMaster(RegimeAwareMaster):
     """One pass of every FMU per macro step, inputs extrapolated; see the module doc."""
 

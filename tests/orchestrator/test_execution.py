@@ -116,8 +116,10 @@ class _Spy:
         return master
 
 
-def _scene_for(algorithm: str, every: int):
+def _scene_for(algorithm: str, every: int, hold: str | None = None):
     overrides = {"master.algorithm": algorithm, "output.every": every}
+    if hold is not None:
+        overrides["master.input_hold"] = hold
     if algorithm not in TOLERANCE_MASTERS:
         return load_scene(SCENARIOS / "two_inertias.toml", overrides | {"scene.stop": "0.1 s"})
     # The M739's first 4 ms: a dozen escapement switches, each recorded on both sides.
@@ -125,23 +127,32 @@ def _scene_for(algorithm: str, every: int):
     return load_scene(SCENARIOS / "m739.toml", overrides)
 
 
-@pytest.mark.parametrize("algorithm", ALGORITHMS)
+#: Every master, the regime-aware one with each of its schemes.
+MASTERS_AND_SCHEMES = [
+    *((a, None) for a in ALGORITHMS if a not in TOLERANCE_MASTERS),
+    *((a, hold) for a in TOLERANCE_MASTERS for hold in ("midpoint", "extrapolated")),
+]
+
+
+@pytest.mark.parametrize(("algorithm", "hold"), MASTERS_AND_SCHEMES)
 def test_output_every_thins_the_record_of_every_master(
-    tmp_path, fmu_cache, monkeypatch, algorithm
+    tmp_path, fmu_cache, monkeypatch, algorithm, hold
 ) -> None:
     """Every 7th macro step and the last are recorded (a step onto a switch with its values
-    just before it); the run itself, its statistics, its events and its energy residual are
-    those of the full record, and each recorded row is the full record's row, bit for bit."""
+    just before it, where the master has them); the run itself, its statistics, its events
+    and its energy residual are those of the full record, and each recorded row is the full
+    record's row, bit for bit."""
     spy = _Spy(execution.MASTERS[algorithm])
     monkeypatch.setitem(execution.MASTERS, algorithm, spy)
-    full = _run(tmp_path, fmu_cache, _scene_for(algorithm, 1), "full")
+    full = _run(tmp_path, fmu_cache, _scene_for(algorithm, 1, hold), "full")
     steps, spy.steps = spy.steps, []
-    thinned = _run(tmp_path, fmu_cache, _scene_for(algorithm, 7), "thinned")
+    thinned = _run(tmp_path, fmu_cache, _scene_for(algorithm, 7, hold), "thinned")
     assert full.status == thinned.status == "completed"
     assert [(s.end, s.h) for s in spy.steps] == [(s.end, s.h) for s in steps]
     assert len(steps) == full.stats.steps > 20
     if algorithm in TOLERANCE_MASTERS:
         assert sum(s.switched for s in steps) >= 10
+    if hold == "midpoint":  # the single pass lands past the switch: no row before it
         assert any(s.left_row is not None for s in steps[6::7])  # a switch among those kept
     for key in ("steps", "do_steps", "rejections", "rollbacks", "iterations", "events"):
         assert getattr(thinned.stats, key) == getattr(full.stats, key), key

@@ -28,7 +28,7 @@ def test_every_master_has_settings_and_every_key_is_a_field() -> None:
     assert TOLERANCE_MASTERS == ("regime-aware",)
     fields = {f.name for cls in SETTINGS.values() for f in dataclasses.fields(cls)}
     assert set(SETTING_KINDS) <= fields
-    assert SETTING_KINDS["input_hold"].choices == ("start", "midpoint", "extrapolated")
+    assert SETTING_KINDS["input_hold"].choices == ("auto", "start", "midpoint", "extrapolated")
     assert SETTING_KINDS["max_iterations"].is_count
     assert SETTING_KINDS["event_tolerance"].unit == "s"
 
@@ -41,7 +41,7 @@ def test_scene_settings_are_typed_with_defaults_filled_in() -> None:
     assert s.event_tolerance == 1e-10 and s.min_step == 1e-14
     assert s.first_step == scene.master.step
     assert s.max_step == min(100.0 * scene.master.step, scene.stop - scene.start)
-    assert s.midpoint and s.control == MasterStepControl()
+    assert s.input_hold == "auto" and s.control == MasterStepControl()
     # A setting another master uses is accepted and ignored.
     jacobi = load_scene(TWO, {"master.algorithm": "jacobi", "master.tolerance": 1e-3})
     assert jacobi.master.settings == FixedStepSettings(jacobi.master.step)
@@ -113,3 +113,27 @@ def test_a_missing_step_names_the_masters_own_key(tmp_path: Path) -> None:
     path.write_text(text)
     with pytest.raises(ScenarioError, match=r"\[master\.first_step\] missing; expected the first"):
         load_scene(path)
+
+
+def test_auto_input_hold_picks_the_single_pass_where_a_copy_judges_the_coupling(
+    tmp_path, fmu_cache
+) -> None:
+    """``input_hold = "auto"`` (the default): the single pass for M739 (the verge reports its
+    copy of the escape wheel), the midpoint hold for two black-box inertias."""
+    from orchestrator.run import run_scene
+
+    chosen = {}
+    for name, path, stop in (("m739", SCENARIOS / "m739.toml", "0.5 ms"), ("two", TWO, "0.01 s")):
+        overrides = {"master.algorithm": "regime-aware", "scene.stop": stop}
+        scene = load_scene(path, overrides)
+        assert scene.master.settings.input_hold == "auto"
+        r = run_scene(
+            scene,
+            output_dir=tmp_path / name,
+            cache_dir=fmu_cache,
+            show_progress=False,
+            plots=False,
+            compare_reference=False,
+        )
+        chosen[name] = r.stats.extra["input_hold"]
+    assert chosen == {"m739": "extrapolated", "two": "midpoint"}
