@@ -364,6 +364,7 @@ class VergeCore:
         self.phi_stop = phi_stop
         self.halted = False
         self.impacts = 0
+        self.pn_peak = 0.0  # largest normal force at an accepted point so far
         self.last_impact: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 0.0)
         self.stall_reason = ""
         self.fault = ""
@@ -465,6 +466,14 @@ class VergeCore:
         return acc, psi_dd, cent
 
     # -- EventModel ---------------------------------------------------------------------
+    def accept(self, y: list[float], t: float) -> None:
+        """An accepted internal point: the normal force's peak between communication
+        points, which the outputs at step ends miss when steps are long."""
+        if self.coupled:
+            pn = self.coupled_terms(y)[4]
+            if pn > self.pn_peak:
+                self.pn_peak = pn
+
     def deriv(self, y: list[float]) -> list[float]:
         w = y[1]
         if self.coupled:
@@ -936,6 +945,13 @@ class VergeEscapement(Component):
             "tooth-face normal force (coupled)",
             depends_on=_WHEEL_AND_TRAIN,
         ),
+        Variable(
+            "PN_peak",
+            "output",
+            "N",
+            0.0,
+            "largest normal force so far, at every internal step (peaks between steps)",
+        ),
         Variable("face", "output", "1", ENTRANCE, "+1 entrance face active, -1 exit", "Integer"),
         Variable(
             "ind_face_end",
@@ -1103,6 +1119,7 @@ class VergeEscapement(Component):
         if core.coupled:
             acc, psi, psi_d, _, pn, t_esc, g, u, *_, t_static, j_esc = core.coupled_terms(y)
             self.PN, self.T_esc, self.ind_pn = pn, t_esc, pn
+            core.pn_peak = max(core.pn_peak, pn)
             self.T_esc_static, self.J_esc = t_static, j_esc
             self.J_load = k.ip * u * u
             self.ind_face_end = core.face * g
@@ -1114,6 +1131,7 @@ class VergeEscapement(Component):
             self.T_esc_static = self.J_esc = 0.0
             ind = core.indicators(y)
             self.ind_face_end, self.ind_gap = ind[IND_FACE_END], ind[IND_CONTACT]
+        self.PN_peak = core.pn_peak
         self.v_close = core.closing_speed(y)[0]
         self.phi_ddot = acc
         self.phi_own, self.phi_dot_own = y[0], y[1]

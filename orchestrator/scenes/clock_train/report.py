@@ -38,6 +38,7 @@ from orchestrator.scenes.m739.report import (
     escapement_arguments,
     escapement_figure,
     instance_names,
+    pn_max,
     reference_from,
     save_figure,
     turns_to_arm,
@@ -75,7 +76,7 @@ def analyse(
     for name, mask in (("F23", coupled), ("F12", coupled), ("FF23", ~coupled), ("FF12", ~coupled)):
         source = col[f"{train}.{name}"]  # F*: coupled motion, FF*: free motion (as the M739's)
         out[f"{name}_max"] = quantity(float(np.max(source[mask])) if mask.any() else 0.0, "N")
-    out["PN_max"] = quantity(float(np.max(col[f"{verge}.PN"])), "N")
+    out["PN_max"] = quantity(pn_max(col, verge), "N")
     out["impacts"] = quantity(float(col[f"{verge}.impact_count"][-1]), "1")
     if f"{train}.handovers" in col:
         out["handovers"] = quantity(float(col[f"{train}.handovers"][-1]), "1")

@@ -96,9 +96,17 @@ def analyse(
     for name, mask in (("F23", coupled), ("F12", coupled), ("FF23", ~coupled), ("FF12", ~coupled)):
         source = col[f"{train}.{name}"]  # F*: coupled motion, FF*: free motion (the report's)
         out[f"{name}_max"] = quantity(float(np.max(source[mask])) if mask.any() else 0.0, "N")
-    out["PN_max"] = quantity(float(np.max(col[f"{verge}.PN"])), "N")
+    out["PN_max"] = quantity(pn_max(col, verge), "N")
     out["impacts"] = quantity(float(col[f"{verge}.impact_count"][-1]), "1")
     return out
+
+
+def pn_max(col: dict[str, np.ndarray], verge: str) -> float:
+    """The largest tooth-face normal force: the verge's own peak over its internal steps
+    where recorded (``PN_peak``), else the largest recorded value."""
+    recorded = float(np.max(col[f"{verge}.PN"]))
+    peak = col.get(f"{verge}.PN_peak")
+    return recorded if peak is None else max(recorded, float(peak[-1]))
 
 
 def _why_not_armed(scene: Scene, col: dict[str, np.ndarray], train: str) -> str:
