@@ -1095,6 +1095,8 @@ class VergeEscapement(Component):
             mean = 0.0  # free throughout (an early return ends at the first contact)
         self._y = y
         self._g_end = core.indicators(y)
+        if core.coupled:  # the step's end is a point of the motion too
+            core.pn_peak = max(core.pn_peak, core.coupled_terms(y)[4])
         self._outputs(y)
         self.T_esc_mean = self.T_esc_static_mean = mean
 
@@ -1119,7 +1121,6 @@ class VergeEscapement(Component):
         if core.coupled:
             acc, psi, psi_d, _, pn, t_esc, g, u, *_, t_static, j_esc = core.coupled_terms(y)
             self.PN, self.T_esc, self.ind_pn = pn, t_esc, pn
-            core.pn_peak = max(core.pn_peak, pn)
             self.T_esc_static, self.J_esc = t_static, j_esc
             self.J_load = k.ip * u * u
             self.ind_face_end = core.face * g
