@@ -267,7 +267,7 @@ SCHEMES = {
     "single pass": {"master.algorithm": "regime-aware", "master.input_hold": "extrapolated"},
 }
 #: Tolerances tried, loosest first, for a scheme to reach a budget.
-TOLERANCES = (1e-2, 3e-3, 1e-3, 3e-4, 1e-4, 3e-5)
+TOLERANCES = (1e-2, 3e-3, 1e-3, 5e-4, 3e-4, 2e-4, 1e-4, 5e-5, 3e-5)
 #: The tolerances of "the tolerance means accuracy" (issue target 3).
 ACCURACY_TOLERANCES = (1e-1, 1e-2, 1e-3, 1e-4, 1e-5)
 
