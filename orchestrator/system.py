@@ -180,6 +180,28 @@ class CoupledSystem:
         if get is not None:
             self.bools[i] = get()
 
+    def input_dependent(self) -> list[int]:
+        """The instances some of whose read values may change when their inputs are set (an
+        output the FMU declares to depend on an input, one it says nothing about, anything
+        but an output): those to read again after a feed.  Our crank drive, for one, has
+        none: its outputs follow its state."""
+        key = tuple(map(len, self.real_names)), tuple(map(len, self.int_names))
+        if getattr(self, "_dependent_key", None) != key:
+            self._dependent_key = key
+            self._dependent = [i for i in range(len(self.names)) if self._reads_feedthrough(i)]
+        return self._dependent
+
+    def _reads_feedthrough(self, i: int) -> bool:
+        model = self.models[i]
+        for name in (*self.real_names[i], *self.int_names[i], *self.bool_names[i]):
+            var = model.variables.get(name)
+            if var is None or var.causality != "output":
+                return True
+            depends = model.dependencies.get(name)
+            if depends is None or depends:
+                return True
+        return False
+
     def read_all(self) -> None:
         for i in range(len(self.instances)):
             self.read(i)

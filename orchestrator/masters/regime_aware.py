@@ -255,7 +255,8 @@ class RegimeAwareMaster:
         system = self.system
         for i in range(len(system.instances)):
             system.feed(i)
-        system.read_all()
+        for i in system.input_dependent():
+            system.read(i)
 
     def switch_time(self, t: float, h: float, before: _Readings) -> _Switch:
         """Earliest switching instant inside (t, t+h], or None if nothing switched.
@@ -322,7 +323,8 @@ class RegimeAwareMaster:
             old = [list(v) for v in system.values], [list(v) for v in system.ints]
             for i in range(len(system.instances)):
                 system.feed(i)
-            system.read_all()
+            for i in system.input_dependent():
+                system.read(i)
             if (system.values, system.ints) == old:
                 return rounds
         raise RunError(

@@ -1,0 +1,34 @@
+"""Which FMUs the master reads again after setting their inputs: those whose read values
+may depend on them (by the FMU's declared output dependencies)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from orchestrator.scenario import load_scene
+from orchestrator.system import CoupledSystem
+
+SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
+
+
+def _dependent(scene_file: str, record: list[str] | None = None) -> list[str]:
+    overrides = {"master.algorithm": "regime-aware"}
+    if record is not None:
+        overrides["output.record"] = record
+    system = CoupledSystem(load_scene(SCENARIOS / scene_file, overrides))
+    try:
+        return [system.names[i] for i in system.input_dependent()]
+    finally:
+        system.close()
+
+
+def test_an_fmu_whose_outputs_follow_its_state_is_not_read_again() -> None:
+    # The crank drive's outputs follow its state; the clutch torque and the brake's
+    # breakaway indicator depend on their inputs.
+    assert _dependent("press_feed_run1.toml") == ["clutch", "load"]
+
+
+def test_reading_an_input_makes_an_fmu_input_dependent() -> None:
+    # Recording the drive's own input (the clutch torque it takes) changes with a feed.
+    needed = ["drive.regime", "clutch.regime", "clutch.windup", "load.regime", "load.feed_length"]
+    assert "drive" in _dependent("press_feed_run1.toml", [*needed, "drive.torque"])
