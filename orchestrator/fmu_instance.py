@@ -121,6 +121,7 @@ class FmuInstance:
     def __init__(self, instance_name: str, fmu_path: Path) -> None:
         self.name = instance_name
         self.path = Path(fmu_path)
+        self.restores = 0  # states restored so far (inputs set before are no longer held)
         md, unzip_dir = _unpacked(str(self.path))
         self.model_description = md
         self.variables = {v.name: v for v in md.modelVariables}
@@ -350,6 +351,7 @@ class FmuInstance:
 
     def set_state(self, state: Any) -> None:
         self._set_state(self.fmu.component, state)
+        self.restores += 1  # its inputs are those of the state now, not the last ones set
 
     def free_state(self, state: Any) -> None:
         self._free_state(self.fmu.component, byref(state))

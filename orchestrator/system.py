@@ -111,6 +111,9 @@ class CoupledSystem:
             inst.getter(inst.refs(names), boolean=True) if names else None
             for inst, names in zip(self.instances, self.bool_names, strict=True)
         ]
+        #: per instance, (its restore count, values) last set through ``feed``
+        self._fed_reals: list[tuple[int, list[float]] | None] = [None for _ in self.names]
+        self._fed_ints: list[tuple[int, list[int]] | None] = [None for _ in self.names]
         self.values: list[list[float]] = [[] for _ in self.names]
         self.ints: list[list[int]] = [[] for _ in self.names]
         self.bools: list[list[int]] = [[] for _ in self.names]
@@ -213,16 +216,25 @@ class CoupledSystem:
         inputs from ``reals`` instead, when given, in the order of ``feeds[i]``; its Integer
         inputs from ``ints``, values read like ``self.ints``, when given)."""
         feed = self.feeds[i]
+        # Values equal to those the FMU holds are not set again: a set makes our FMUs
+        # recompute their outputs, and a step's held inputs are often the ones the exchange
+        # at its start set.  A restored state brings its own inputs (``restores``).
+        restores = self.instances[i].restores
         set_reals = self._set_reals[i]
         if set_reals is not None:
             if reals is None:
                 values = self.values
                 reals = [values[s][k] for s, k in feed.real_sources]
-            set_reals(reals)
+            if self._fed_reals[i] != (restores, reals):
+                set_reals(reals)
+                self._fed_reals[i] = (restores, reals)
         set_ints = self._set_ints[i]
         if set_ints is not None:
             ints = self.ints if ints is None else ints
-            set_ints([ints[s][k] for s, k in feed.int_sources])
+            values = [ints[s][k] for s, k in feed.int_sources]
+            if self._fed_ints[i] != (restores, values):
+                set_ints(values)
+                self._fed_ints[i] = (restores, values)
 
     def step(self, i: int, t: float, h: float) -> None:
         drive = self._drive

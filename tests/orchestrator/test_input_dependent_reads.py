@@ -32,3 +32,25 @@ def test_reading_an_input_makes_an_fmu_input_dependent() -> None:
     # Recording the drive's own input (the clutch torque it takes) changes with a feed.
     needed = ["drive.regime", "clutch.regime", "clutch.windup", "load.regime", "load.feed_length"]
     assert "drive" in _dependent("press_feed_run1.toml", [*needed, "drive.torque"])
+
+
+def test_values_an_fmu_holds_are_not_set_again_until_a_state_is_restored() -> None:
+    system = CoupledSystem(load_scene(SCENARIOS / "two_inertias.toml"))
+    try:
+        system.initialize()
+        i = next(i for i, s in enumerate(system._set_reals) if s is not None)
+        sets = []
+        real_set = system._set_reals[i]
+        system._set_reals[i] = lambda values: (sets.append(list(values)), real_set(values))
+        state = system.get_state()
+        system.feed(i, [1.5])
+        system.feed(i, [1.5])  # the FMU holds 1.5: not set again
+        assert sets == [[1.5]]
+        system.feed(i, [2.5])
+        assert sets == [[1.5], [2.5]]
+        system.restore(state)  # the state's own inputs are back: set again
+        system.feed(i, [2.5])
+        assert sets == [[1.5], [2.5], [2.5]]
+        system.free_state(state)
+    finally:
+        system.close()
