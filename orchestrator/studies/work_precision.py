@@ -37,6 +37,7 @@ from orchestrator.studies.monolithic_curve import (
     TRUTH_TOLERANCE,
     WINDOW,
     MonolithicCurve,
+    envelope_time,
     monolithic_curve,
     monolithic_model,
     time_in_window,
@@ -305,10 +306,10 @@ def plot_records(records: list[dict[str, Any]], reference_time: float, name: str
                 if r["master"] == master and r["status"] == "completed"
             ]
             pts = sorted((x, y) for x, y in pts if y > 0 and math.isfinite(y))
-            if pts:
-                mono = master == MONOLITHIC
-                style = {"color": "black", "ls": "--", "marker": "s"} if mono else {"marker": "o"}
-                ax.loglog(*zip(*pts, strict=True), **style, label=master)
+            if pts and master == MONOLITHIC:
+                _draw_monolithic(ax, pts)
+            elif pts:
+                ax.loglog(*zip(*pts, strict=True), "o-", label=master)
         if reference_time > 0:
             ax.axvline(reference_time, color="grey", ls=":", label="reference run time")
         if error == "turns_error":
@@ -327,6 +328,18 @@ def plot_records(records: list[dict[str, Any]], reference_time: float, name: str
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
+
+
+def _draw_monolithic(ax: Any, pts: list[tuple[float, float]]) -> None:
+    """The monolithic runs as points, and the envelope the ratios are read off: for each
+    error, the least time of a run at least that accurate (a staircase)."""
+    ax.loglog(*zip(*pts, strict=True), "ks", label=MONOLITHIC)
+    errors = np.logspace(np.log10(min(e for _, e in pts)), np.log10(max(e for _, e in pts)), 400)
+    times = [envelope_time([(e, t) for t, e in pts], x) for x in errors]
+    ax.loglog(times, errors, "k-", lw=1.2, label=f"{MONOLITHIC}: least time for an error")
+    ax.loglog(
+        [TARGET_RATIO * t for t in times], errors, "k:", lw=1.2, label=f"{TARGET_RATIO:g}x that"
+    )
 
 
 def _g(x: float) -> str:
