@@ -414,7 +414,7 @@ def _precision(args: argparse.Namespace) -> int:
     )
 
     if args.repeats < 1:
-        raise ScenarioError("--repeats", str(args.repeats), "expected a whole number >= 1")
+        raise ScenarioError("--repeats", "", f"expected a whole number >= 1, got {args.repeats}")
     rows = work_precision(
         args.scene,
         args.output,

@@ -94,12 +94,13 @@ def monolithic_curve(
     model: Callable[[float], Any],
     tolerances: Sequence[float] = CURVE_TOLERANCES,
     repeats: int = REPEATS,
-) -> MonolithicCurve:
-    """Run ``model(tolerance)`` (a result with ``armed`` and ``turns``) at the truth's
-    tolerance and at each of ``tolerances``, timed, errors against the truth."""
+) -> MonolithicCurve | str:
+    """Run ``model(tolerance)`` (a result with ``armed``, ``turns`` and ``reason``) at the
+    truth's tolerance and at each of ``tolerances``, timed, errors against the truth.
+    When the truth does not arm (e.g. a stop before arming), why, instead of a curve."""
     truth_time, truth = _best_time(lambda: model(TRUTH_TOLERANCE), 1)
     if not truth.armed:
-        raise ValueError(f"the monolithic model did not arm at tolerance 1e-12: {truth.reason}")
+        return f"did not arm at tolerance {TRUTH_TOLERANCE:g} ({truth.reason}): no turns error"
     curve = MonolithicCurve(truth.turns, truth_time, [])
     for tol in tolerances:
         wall, result = _best_time(lambda tol=tol: model(tol), repeats)

@@ -197,9 +197,11 @@ def work_precision(
     out_dir.mkdir(parents=True, exist_ok=True)
     reference = reference_of(scene)
     model = monolithic_model(scene)
-    curve = None
+    curve, notes = None, []
     if model is not None:
         curve = monolithic_curve(model, monolithic_tolerances, monolithic_repeats)
+        if isinstance(curve, str):
+            curve, notes = None, [f"The monolithic model {curve}."]
     jobs = sweep_jobs(
         scene_path, scene, out_dir, step_factors, tolerances, start_hold_tolerances, overrides
     )
@@ -227,7 +229,7 @@ def work_precision(
     records = [r.as_dict() for r in rows] + monolithic_records(curve)
     _write_csv(records, out_dir / "work_precision.csv")
     plot_records(records, reference.wall_time, scene.name, out_dir / "work_precision.png")
-    text = summary(rows, curve, scene, reference.wall_time, repeats, monolithic_repeats)
+    text = summary(rows, curve, scene, reference.wall_time, repeats, monolithic_repeats, notes)
     (out_dir / "work_precision.md").write_text(text)
     return rows
 
@@ -296,7 +298,7 @@ def plot_records(records: list[dict[str, Any]], reference_time: float, name: str
     from matplotlib.ticker import NullFormatter
 
     turns = any(math.isfinite(_float(r.get("turns_error"))) for r in records)
-    fig, axes = plt.subplots(1, 2, figsize=(11, 4.5))
+    fig, axes = plt.subplots(1, 2, figsize=(14 if turns else 11, 4.5))
     panels = ("trajectory_error", "turns_error" if turns else "headline_error")
     for ax, error in zip(axes, panels, strict=True):
         for master in dict.fromkeys(r["master"] for r in records):
@@ -323,7 +325,10 @@ def plot_records(records: list[dict[str, Any]], reference_time: float, name: str
         }.get(error, error.replace("_", " ") + " (relative)")
         ax.set_ylabel(label)
         ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize="small")
+        if error == "turns_error":  # beside the axes: the monolithic curve spans them
+            ax.legend(fontsize="small", loc="upper left", bbox_to_anchor=(1.02, 1.0))
+        else:
+            ax.legend(fontsize="small")
     fig.suptitle(f"{name}: work–precision")
     fig.tight_layout()
     fig.savefig(path, dpi=110)
@@ -353,6 +358,7 @@ def summary(
     reference_time: float,
     repeats: int = 1,
     monolithic_repeats: int = REPEATS,
+    notes: list[str] | None = None,
 ) -> str:
     """The Markdown report: every run, the monolithic curve, and the two verdicts (time
     against the monolithic model in the turns-error window; error against tolerance)."""
@@ -363,6 +369,7 @@ def summary(
         f"Reference: `{scene.reference}` ({reference_time:.3g} s). {len(rows)} runs; master "
         f"wall times: {timing}. Headline error: the largest relative error of the headline "
         "quantities against the reference; trajectory error: relative, against the reference.",
+        *(["", *notes] if notes else []),
     ]
     if curve is not None:
         lines += [

@@ -76,6 +76,9 @@ def test_monolithic_curve_times_each_tolerance_against_the_truth() -> None:
     assert math.isnan(curve.points[0].error)
     assert [p.error for p in curve.points[1:]] == pytest.approx([1e-3, 1e-5], rel=1e-6)
     assert all(p.wall_time > 0 for p in curve.points)
+    # A truth that does not arm (a stop before arming) gives the reason, not a curve.
+    never = monolithic_curve(lambda tolerance: SimpleNamespace(armed=False, reason="stop"), (1e-3,))
+    assert never == "did not arm at tolerance 1e-12 (stop): no turns error"
 
 
 def _row(master, tol, wall, turns_error, mono=math.nan, setting="tolerance") -> Row:
