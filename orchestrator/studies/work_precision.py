@@ -119,6 +119,8 @@ class Row:
 #: Label of the regime-aware master with inputs held at the step start (the baseline that
 #: the default midpoint hold is measured against).
 START_HOLD = "regime-aware/start"
+#: The fixed-step masters, swept over macro steps.
+FIXED_STEP = ("jacobi", "gauss-seidel")
 #: Label of the regime-aware master's single pass (``input_hold = "extrapolated"``).
 ONE_PASS = "regime-aware/one-pass"
 
@@ -147,7 +149,7 @@ def sweep_jobs(
         )
 
     jobs = []
-    for master in ("jacobi", "gauss-seidel"):
+    for master in FIXED_STEP:
         for f in step_factors:
             h = scene.master.step * f
             if h <= scene.stop - scene.start:
@@ -216,11 +218,9 @@ def work_precision(
         accuracy = {}
         if res.status == "completed":
             accuracy = compare(res.header, res.data, res.events, res.headline, reference)
-        setting, value = (
-            ("tolerance", job.overrides["master.tolerance"])
-            if "master.tolerance" in job.overrides
-            else ("step", job.overrides["master.step"])
-        )
+        # By the master, not by the keys: --set may put either key into every job.
+        setting = "step" if job.label in FIXED_STEP else "tolerance"
+        value = job.overrides[f"master.{setting}"]
         row = Row(job.label, setting, value, res, accuracy, wall_time=wall)
         if curve is not None and res.status == "completed" and QUANTITY in res.headline:
             row.turns_error = curve.relative_error(float(res.headline[QUANTITY]["value"]))
