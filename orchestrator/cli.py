@@ -114,7 +114,8 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument(
         "--tolerances",
         type=_floats,
-        help="tolerances of the tolerance-driven masters, comma-separated (default 1e-2,...,1e-4)",
+        help="tolerances of the tolerance-driven masters and the regime-aware single pass, "
+        "comma-separated (default 1e-1,1e-2,...,1e-5)",
     )
     p.add_argument(
         "--step-factors",
@@ -127,6 +128,19 @@ def main(argv: list[str] | None = None) -> int:
         help="also run the regime-aware master with inputs held at the step start "
         "(input_hold = 'start', the first-order error test) at these tolerances",
     )
+    p.add_argument(
+        "--monolithic-tolerances",
+        type=_floats,
+        help="tolerances of the scene's monolithic model, where its family has one "
+        "(default 1e-3,3e-4,...,1e-10)",
+    )
+    p.add_argument(
+        "--repeats",
+        type=int,
+        default=1,
+        help="run every master setting this many times and keep its least wall time (default 1)",
+    )
+    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
     p.set_defaults(handler=_precision)
 
     p = sub.add_parser("sweep", help="run a scene's [sweep]: one run per value, CSV/PNG/table")
@@ -391,6 +405,7 @@ def _crosscheck(args: argparse.Namespace) -> int:
 
 
 def _precision(args: argparse.Namespace) -> int:
+    from orchestrator.studies.monolithic_curve import CURVE_TOLERANCES
     from orchestrator.studies.work_precision import (
         STEP_FACTORS,
         TOLERANCES,
@@ -398,6 +413,8 @@ def _precision(args: argparse.Namespace) -> int:
         work_precision,
     )
 
+    if args.repeats < 1:
+        raise ScenarioError("--repeats", "", f"expected a whole number >= 1, got {args.repeats}")
     rows = work_precision(
         args.scene,
         args.output,
@@ -406,9 +423,17 @@ def _precision(args: argparse.Namespace) -> int:
         start_hold_tolerances=args.start_hold_tolerances or (),
         workers=args.workers,
         dask_address=args.dask,
+        overrides=_overrides(args.set),
+        repeats=args.repeats,
+        monolithic_tolerances=args.monolithic_tolerances or CURVE_TOLERANCES,
     )
     for master in dict.fromkeys(r.master for r in rows):
-        print(f"  {master:20s} observed order {observed_order(rows, master):.2f}")
+        line = f"  {master:22s} observed order {observed_order(rows, master):.2f}"
+        ratios = [r.monolithic_ratio for r in rows if r.master == master]
+        ratios = [x for x in ratios if not math.isnan(x)]  # those in the turns-error window
+        if ratios:
+            line += f", x monolithic at the same turns error {min(ratios):.2f}..{max(ratios):.2f}"
+        print(line)
     out = Path(rows[0].result.job.output_dir).parent if rows else args.output
     print(f"report in {out}/work_precision.md (.csv, .png)")
     return 0

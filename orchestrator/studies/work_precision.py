@@ -1,9 +1,16 @@
 """Work–precision report: error against wall time for every master setting of a scene.
 
 One command runs the scene's reference once, then sweeps the masters (fixed-step Jacobi and
-Gauss–Seidel over macro steps; tolerance-driven masters over tolerances) on a process pool
-or a Dask cluster, and writes ``work_precision.csv``, ``work_precision.png`` and
-``work_precision.md`` with the observed convergence order of each master.
+Gauss–Seidel over macro steps; tolerance-driven masters, and the regime-aware master's
+single pass, over tolerances) on a process pool or a Dask cluster, and writes
+``work_precision.csv``, ``work_precision.png`` and ``work_precision.md`` with the observed
+convergence order of each master.
+
+Where the scene's family has a monolithic model (``monolithic_curve.MODELS``), that model
+also runs over its own tolerances; its curve is drawn with the masters on the turns-error
+panel, and each master point in the turns-error window 1e-6 .. 1e-3 gets the ratio of its
+time to the monolithic model's time at the same accuracy.  Each tolerance-driven point is
+flagged when its error (turns error, else the largest headline error) exceeds its tolerance.
 """
 
 from __future__ import annotations
@@ -22,9 +29,22 @@ from orchestrator.masters import TOLERANCE_MASTERS
 from orchestrator.run import reference_of
 from orchestrator.scenario import Scene, load_scene
 from orchestrator.studies.jobs import Job, JobResult, run_jobs
+from orchestrator.studies.monolithic_curve import (
+    CURVE_TOLERANCES,
+    QUANTITY,
+    REPEATS,
+    TARGET_RATIO,
+    TRUTH_TOLERANCE,
+    WINDOW,
+    MonolithicCurve,
+    envelope_time,
+    monolithic_curve,
+    monolithic_model,
+    time_in_window,
+)
 
 STEP_FACTORS = (8.0, 4.0, 2.0, 1.0, 0.5, 0.25)
-TOLERANCES = (1e-2, 3e-3, 1e-3, 3e-4, 1e-4)
+TOLERANCES = (1e-1, 1e-2, 1e-3, 1e-4, 1e-5)
 COUNTERS = ("steps", "do_steps", "rollbacks", "rejections", "iterations", "events")
 COLUMNS = [
     "master",
@@ -32,6 +52,10 @@ COLUMNS = [
     "value",
     "status",
     "wall_time",
+    "turns_error",
+    "monolithic_time",
+    "monolithic_ratio",
+    "within_tolerance",
     "headline_error",
     "trajectory_error",
     "event_time_error",
@@ -47,6 +71,29 @@ class Row:
     value: float
     result: JobResult
     accuracy: dict[str, float]
+    #: relative turns error against the monolithic truth (NaN: no monolithic model)
+    turns_error: float = math.nan
+    monolithic_time: float = math.nan  # the monolithic model's time for turns_error
+    #: best wall time of the repeats (the result's own when run once)
+    wall_time: float = math.nan
+
+    @property
+    def monolithic_ratio(self) -> float:
+        return self.wall_time / self.monolithic_time if self.monolithic_time > 0 else math.nan
+
+    @property
+    def error(self) -> float:
+        """The error the tolerance is held against: turns error, else largest headline."""
+        if math.isfinite(self.turns_error):
+            return self.turns_error
+        return self.accuracy.get("headline_error", math.nan)
+
+    @property
+    def within_tolerance(self) -> str:
+        """'yes' / 'no' for a tolerance-driven point, '' otherwise (or no error)."""
+        if self.setting != "tolerance" or not math.isfinite(self.error):
+            return ""
+        return "yes" if self.error <= self.value else "no"
 
     def as_dict(self) -> dict[str, Any]:
         stats = self.result.stats
@@ -56,7 +103,11 @@ class Row:
             "setting": self.setting,
             "value": self.value,
             "status": self.result.status,
-            "wall_time": stats.get("wall_time", math.nan),
+            "wall_time": self.wall_time,
+            "turns_error": self.turns_error,
+            "monolithic_time": self.monolithic_time,
+            "monolithic_ratio": self.monolithic_ratio,
+            "within_tolerance": self.within_tolerance,
             "headline_error": self.accuracy.get("headline_error", math.nan),
             "trajectory_error": self.accuracy.get("trajectory_error", math.nan),
             "event_time_error": self.accuracy.get("event_time_error", math.nan),
@@ -68,6 +119,10 @@ class Row:
 #: Label of the regime-aware master with inputs held at the step start (the baseline that
 #: the default midpoint hold is measured against).
 START_HOLD = "regime-aware/start"
+#: The fixed-step masters, swept over macro steps.
+FIXED_STEP = ("jacobi", "gauss-seidel")
+#: Label of the regime-aware master's single pass (``input_hold = "extrapolated"``).
+ONE_PASS = "regime-aware/one-pass"
 
 
 def sweep_jobs(
@@ -77,13 +132,16 @@ def sweep_jobs(
     step_factors,
     tolerances,
     start_hold_tolerances=(),
+    base: dict[str, Any] | None = None,
 ) -> list[Job]:
+    """The sweep's runs; ``base`` overrides go into every one (e.g. a shorter stop)."""
+
     def job(overrides: dict, directory: str, label: str) -> Job:
         # The study compares every run with one reference it computes itself, and draws
         # one diagram of them all (a plot per run would cost more than most runs).
         return Job(
             str(scene_path),
-            overrides,
+            {**(base or {}), **overrides},
             str(out_dir / directory),
             label,
             compare_reference=False,
@@ -91,7 +149,7 @@ def sweep_jobs(
         )
 
     jobs = []
-    for master in ("jacobi", "gauss-seidel"):
+    for master in FIXED_STEP:
         for f in step_factors:
             h = scene.master.step * f
             if h <= scene.stop - scene.start:
@@ -101,6 +159,13 @@ def sweep_jobs(
         for tol in tolerances:
             overrides = {"master.algorithm": master, "master.tolerance": tol}
             jobs.append(job(overrides, f"{master}_tol{tol:.0e}", master))
+    for tol in tolerances:
+        overrides = {
+            "master.algorithm": "regime-aware",
+            "master.tolerance": tol,
+            "master.input_hold": "extrapolated",
+        }
+        jobs.append(job(overrides, f"regime-aware-one-pass_tol{tol:.0e}", ONE_PASS))
     for tol in start_hold_tolerances:
         overrides = {
             "master.algorithm": "regime-aware",
@@ -119,32 +184,79 @@ def work_precision(
     workers: int | None = None,
     dask_address: str | None = None,
     start_hold_tolerances=(),
+    overrides: dict[str, Any] | None = None,
+    repeats: int = 1,
+    monolithic_tolerances=CURVE_TOLERANCES,
+    monolithic_repeats: int = REPEATS,
 ) -> list[Row]:
-    scene = load_scene(scene_path)
+    """Sweep the masters (each run ``repeats`` times, its least wall time kept) and, where
+    the scene has a monolithic model, that model over ``monolithic_tolerances`` (each
+    timed ``monolithic_repeats`` times, before the sweep, in this process)."""
+    scene = load_scene(scene_path, overrides)
     if not scene.reference:
         raise ScenarioError(scene_path, "report.reference", "missing; the report needs a reference")
     out_dir = Path(out_dir or Path("runs") / f"{scene.name}_work_precision")
     out_dir.mkdir(parents=True, exist_ok=True)
     reference = reference_of(scene)
-    jobs = sweep_jobs(scene_path, scene, out_dir, step_factors, tolerances, start_hold_tolerances)
+    model = monolithic_model(scene)
+    curve, notes = None, []
+    if model is not None:
+        curve = monolithic_curve(model, monolithic_tolerances, monolithic_repeats)
+        if isinstance(curve, str):
+            curve, notes = None, [f"The monolithic model {curve}."]
+    jobs = sweep_jobs(
+        scene_path, scene, out_dir, step_factors, tolerances, start_hold_tolerances, overrides
+    )
     results = run_jobs(jobs, workers=workers, dask_address=dask_address)
+    walls = [r.stats.get("wall_time", math.nan) for r in results]
+    for _ in range(repeats - 1):  # after the first round, so that no two write one directory
+        again = run_jobs(jobs, workers=workers, dask_address=dask_address)
+        again_walls = [r.stats.get("wall_time", math.nan) for r in again]
+        walls = [min(a, b) for a, b in zip(walls, again_walls, strict=True)]
     rows = []
-    for job, res in zip(jobs, results, strict=True):
+    for job, res, wall in zip(jobs, results, walls, strict=True):
         accuracy = {}
         if res.status == "completed":
             accuracy = compare(res.header, res.data, res.events, res.headline, reference)
-        setting, value = (
-            ("tolerance", job.overrides["master.tolerance"])
-            if "master.tolerance" in job.overrides
-            else ("step", job.overrides["master.step"])
-        )
-        rows.append(Row(job.label, setting, value, res, accuracy))
-    _write_csv(rows, out_dir / "work_precision.csv")
-    plot_records(
-        [r.as_dict() for r in rows], reference.wall_time, scene.name, out_dir / "work_precision.png"
-    )
-    _write_summary(rows, scene, reference.wall_time, out_dir / "work_precision.md")
+        # By the master, not by the keys: --set may put either key into every job.
+        setting = "step" if job.label in FIXED_STEP else "tolerance"
+        value = job.overrides[f"master.{setting}"]
+        row = Row(job.label, setting, value, res, accuracy, wall_time=wall)
+        if curve is not None and res.status == "completed" and QUANTITY in res.headline:
+            row.turns_error = curve.relative_error(float(res.headline[QUANTITY]["value"]))
+            row.monolithic_time = time_in_window(curve, row.turns_error)
+        rows.append(row)
+    records = [r.as_dict() for r in rows] + monolithic_records(curve)
+    _write_csv(records, out_dir / "work_precision.csv")
+    plot_records(records, reference.wall_time, scene.name, out_dir / "work_precision.png")
+    text = summary(rows, curve, scene, reference.wall_time, repeats, monolithic_repeats, notes)
+    (out_dir / "work_precision.md").write_text(text)
     return rows
+
+
+#: The label of the monolithic model's rows in the CSV and its line in the diagram.
+MONOLITHIC = "monolithic"
+
+
+def monolithic_records(curve: MonolithicCurve | None) -> list[dict[str, Any]]:
+    """The monolithic curve as table rows (the columns the masters' rows have)."""
+    if curve is None:
+        return []
+    out = []
+    for p in curve.points:
+        record: dict[str, Any] = dict.fromkeys(COLUMNS, math.nan)
+        record.update(
+            master=MONOLITHIC,
+            setting="tolerance",
+            value=p.tolerance,
+            status="completed" if math.isfinite(p.error) else "not armed",
+            wall_time=p.wall_time,
+            turns_error=p.error,
+            within_tolerance="",
+            **dict.fromkeys(COUNTERS, ""),
+        )
+        out.append(record)
+    return out
 
 
 def observed_order(rows: list[Row], master: str, error: str = "trajectory_error") -> float:
@@ -161,67 +273,200 @@ def observed_order(rows: list[Row], master: str, error: str = "trajectory_error"
     return float(np.polyfit(x, y, 1)[0])
 
 
-def _write_csv(rows: list[Row], path: Path) -> None:
+def _write_csv(records: list[dict[str, Any]], path: Path) -> None:
     with open(path, "w", newline="") as f:
         writer = csv.DictWriter(f, fieldnames=COLUMNS)
         writer.writeheader()
-        for r in rows:
-            writer.writerow(r.as_dict())
+        writer.writerows(records)
+
+
+def _float(value: Any) -> float:
+    try:
+        return float(value)
+    except (TypeError, ValueError):
+        return math.nan
 
 
 def plot_records(records: list[dict[str, Any]], reference_time: float, name: str, path: Path):
-    """The diagram from table rows (``Row.as_dict`` or the CSV read back with float values)."""
+    """The diagram from table rows (``Row.as_dict`` and ``monolithic_records``, or the CSV
+    read back).  The right panel is the turns error when the rows have one (the monolithic
+    curve on the same axes), else the largest headline error."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     from matplotlib.ticker import NullFormatter
 
-    fig, axes = plt.subplots(1, 2, figsize=(11, 4.5))
-    for ax, error in zip(axes, ("trajectory_error", "headline_error"), strict=True):
+    turns = any(math.isfinite(_float(r.get("turns_error"))) for r in records)
+    fig, axes = plt.subplots(1, 2, figsize=(14 if turns else 11, 4.5))
+    panels = ("trajectory_error", "turns_error" if turns else "headline_error")
+    for ax, error in zip(axes, panels, strict=True):
         for master in dict.fromkeys(r["master"] for r in records):
             pts = [
-                (float(r["wall_time"]), float(r[error]))
+                (_float(r["wall_time"]), _float(r[error]))
                 for r in records
                 if r["master"] == master and r["status"] == "completed"
             ]
             pts = sorted((x, y) for x, y in pts if y > 0 and math.isfinite(y))
-            if pts:
+            if pts and master == MONOLITHIC:
+                _draw_monolithic(ax, pts)
+            elif pts:
                 ax.loglog(*zip(*pts, strict=True), "o-", label=master)
         if reference_time > 0:
             ax.axvline(reference_time, color="grey", ls=":", label="reference run time")
+        if error == "turns_error":
+            for level in WINDOW:  # the accuracies compared with the monolithic model
+                ax.axhline(level, color="grey", lw=0.8, ls="-.")
         ax.xaxis.set_minor_formatter(NullFormatter())  # minor labels collide on short spans
         ax.set_xlabel("wall time [s]")
-        ax.set_ylabel(error.replace("_", " ") + " (relative)")
+        label = {
+            "turns_error": "turns error (relative, vs monolithic at 1e-12)",
+            "headline_error": "largest headline error (relative)",
+        }.get(error, error.replace("_", " ") + " (relative)")
+        ax.set_ylabel(label)
         ax.grid(True, which="both", alpha=0.3)
-        ax.legend()
+        if error == "turns_error":  # beside the axes: the monolithic curve spans them
+            ax.legend(fontsize="small", loc="upper left", bbox_to_anchor=(1.02, 1.0))
+        else:
+            ax.legend(fontsize="small")
     fig.suptitle(f"{name}: work–precision")
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
 
 
-def _write_summary(rows: list[Row], scene: Scene, reference_time: float, path: Path) -> None:
+def _draw_monolithic(ax: Any, pts: list[tuple[float, float]]) -> None:
+    """The monolithic runs as points, and the envelope the ratios are read off: for each
+    error, the least time of a run at least that accurate (a staircase)."""
+    ax.loglog(*zip(*pts, strict=True), "ks", label=MONOLITHIC)
+    errors = np.logspace(np.log10(min(e for _, e in pts)), np.log10(max(e for _, e in pts)), 400)
+    times = [envelope_time([(e, t) for t, e in pts], x) for x in errors]
+    ax.loglog(times, errors, "k-", lw=1.2, label=f"{MONOLITHIC}: least time for an error")
+    ax.loglog(
+        [TARGET_RATIO * t for t in times], errors, "k:", lw=1.2, label=f"{TARGET_RATIO:g}x that"
+    )
+
+
+def _g(x: float) -> str:
+    return "–" if not math.isfinite(x) else f"{x:.3g}"
+
+
+def summary(
+    rows: list[Row],
+    curve: MonolithicCurve | None,
+    scene: Scene,
+    reference_time: float,
+    repeats: int = 1,
+    monolithic_repeats: int = REPEATS,
+    notes: list[str] | None = None,
+) -> str:
+    """The Markdown report: every run, the monolithic curve, and the two verdicts (time
+    against the monolithic model in the turns-error window; error against tolerance)."""
+    timing = "one run each" if repeats == 1 else f"the least of {repeats} runs"
     lines = [
         f"# Work–precision: {scene.name}",
         "",
-        f"Reference: `{scene.reference}` ({reference_time:.3g} s). "
-        f"{len(rows)} runs; errors are relative to the reference.",
-        "",
-        "| master | setting | value | status | wall time [s] | headline error | trajectory error "
-        "| event-time error [s] | energy residual | doSteps | rollbacks |",
-        "|---|---|---|---|---|---|---|---|---|---|---|",
+        f"Reference: `{scene.reference}` ({reference_time:.3g} s). {len(rows)} runs; master "
+        f"wall times: {timing}. Headline error: the largest relative error of the headline "
+        "quantities against the reference; trajectory error: relative, against the reference.",
+        *(["", *notes] if notes else []),
     ]
+    if curve is not None:
+        lines += [
+            "",
+            "Turns error: |turns - truth| / truth for the master runs and the monolithic runs "
+            f"alike, truth = the monolithic model at tolerance {TRUTH_TOLERANCE:g} "
+            f"({curve.truth:.9g} turns, {curve.truth_wall_time:.3g} s).",
+            "",
+            "x monolithic: the run's wall time / the least time of a monolithic run whose "
+            f"turns error is at most the run's (only for turns errors {WINDOW[0]:g} .. "
+            f"{WINDOW[1]:g}; monolithic times: the least of {monolithic_repeats} runs).",
+        ]
+    error_name = "turns error" if curve is not None else "largest headline error"
+    head = "| master | setting | value | status | wall time [s] |"
+    rule = "|---|---|---|---|---|"
+    if curve is not None:
+        head += " turns error | monolithic time [s] | x monolithic |"
+        rule += "---|---|---|"
+    head += (
+        f" {error_name} <= tolerance | headline error | trajectory error | event-time error [s] "
+        "| energy residual | doSteps | rollbacks |"
+    )
+    rule += "---|---|---|---|---|---|---|"
+    lines += ["", head, rule]
     for r in rows:
         d = r.as_dict()
-        lines.append(
-            f"| {d['master']} | {d['setting']} | {d['value']:.3g} | {d['status']} "
-            f"| {d['wall_time']:.3g} | {d['headline_error']:.3g} | {d['trajectory_error']:.3g} "
-            f"| {d['event_time_error']:.3g} | {d['energy_residual']:.3g} | {d['do_steps']} "
-            f"| {d['rollbacks']} |"
-        )
+        cells = [
+            d["master"],
+            d["setting"],
+            f"{d['value']:.3g}",
+            d["status"],
+            _g(d["wall_time"]),
+        ]
+        if curve is not None:
+            cells += [_g(r.turns_error), _g(r.monolithic_time), _g(r.monolithic_ratio)]
+        flag = {"yes": "yes", "no": "**NO**"}.get(r.within_tolerance, "")
+        cells += [
+            flag,
+            _g(d["headline_error"]),
+            _g(d["trajectory_error"]),
+            _g(d["event_time_error"]),
+            _g(d["energy_residual"]),
+            str(d["do_steps"]),
+            str(d["rollbacks"]),
+        ]
+        lines.append("| " + " | ".join(cells) + " |")
+    if curve is not None:
+        lines += _monolithic_lines(rows, curve, monolithic_repeats)
+    lines += ["", f"The tolerance means accuracy ({error_name} <= tolerance):", ""]
+    for master in dict.fromkeys(r.master for r in rows if r.setting == "tolerance"):
+        points = [r for r in rows if r.master == master and r.within_tolerance]
+        over = [r for r in points if r.within_tolerance == "no"]
+        if not points:
+            lines.append(f"- {master}: no completed run with an error")
+        elif not over:
+            lines.append(f"- {master}: yes at all {len(points)} tolerances")
+        else:
+            worst = ", ".join(f"{_g(r.error)} at {r.value:g}" for r in over)
+            lines.append(f"- {master}: NO at {len(over)} of {len(points)} ({worst})")
     lines += ["", "Observed order (slope of log trajectory error against log setting):", ""]
     for master in dict.fromkeys(r.master for r in rows):
         setting = next(r.setting for r in rows if r.master == master)
         lines.append(f"- {master}: {observed_order(rows, master):.2f} (per {setting})")
-    path.write_text("\n".join(lines) + "\n")
+    return "\n".join(lines) + "\n"
+
+
+def _monolithic_lines(rows: list[Row], curve: MonolithicCurve, repeats: int) -> list[str]:
+    lines = [
+        "",
+        f"Monolithic model over its tolerances (wall time: the least of {repeats} runs):",
+        "",
+        "| tolerance | wall time [s] | turns error |",
+        "|---|---|---|",
+    ]
+    lines += [f"| {p.tolerance:g} | {p.wall_time:.3g} | {_g(p.error)} |" for p in curve.points]
+    lo, hi = WINDOW
+    lines += [
+        "",
+        f"Against the monolithic curve (turns error {lo:g} .. {hi:g}, target <= "
+        f"{TARGET_RATIO:g}x the monolithic time at the same accuracy):",
+        "",
+    ]
+    for master in dict.fromkeys(r.master for r in rows):
+        ratios = [
+            (r.value, r.monolithic_ratio)
+            for r in rows
+            if r.master == master and lo <= r.turns_error <= hi
+        ]
+        if not ratios:
+            lines.append(f"- {master}: no point in the window")
+            continue
+        values = [x for _, x in ratios]
+        verdict = (
+            "every point within"
+            if all(x <= TARGET_RATIO for x in values)
+            else "NOT every point within"
+        )
+        listed = ", ".join(f"{_g(x)} at {v:g}" for v, x in ratios)
+        lines.append(f"- {master}: {verdict} {TARGET_RATIO:g}x ({listed})")
+    return lines

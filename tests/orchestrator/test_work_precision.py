@@ -8,7 +8,12 @@ import numpy as np
 import pytest
 
 from orchestrator.studies.jobs import Job, run_jobs
-from orchestrator.studies.work_precision import START_HOLD, observed_order, work_precision
+from orchestrator.studies.work_precision import (
+    ONE_PASS,
+    START_HOLD,
+    observed_order,
+    work_precision,
+)
 
 SCENE = Path(__file__).resolve().parents[2] / "scenarios" / "two_inertias.toml"
 
@@ -47,7 +52,9 @@ def test_work_precision_report_for_the_two_inertias(tmp_path: Path, fmu_cache, m
         workers=2,
         start_hold_tolerances=(1e-3,),
     )
-    assert len(rows) == 9 and all(r.result.status == "completed" for r in rows)
+    # 3 steps x 2 fixed-step masters, 2 tolerances x (midpoint hold, single pass), 1 baseline
+    assert len(rows) == 11 and all(r.result.status == "completed" for r in rows)
+    assert [r.value for r in rows if r.master == ONE_PASS] == [1e-3, 1e-4]
     # The baseline (inputs held at the step start) at the same tolerance takes more steps.
     start = next(r for r in rows if r.master == START_HOLD)
     mid = next(r for r in rows if r.master == "regime-aware" and r.value == 1e-3)
@@ -61,3 +68,6 @@ def test_work_precision_report_for_the_two_inertias(tmp_path: Path, fmu_cache, m
     assert observed_order(rows, "regime-aware") == pytest.approx(1.0, abs=0.25)
     text = (tmp_path / "wp" / "work_precision.md").read_text()
     assert "Observed order" in text and "jacobi" in text and "event-time error" in text
+    # No monolithic model for this family: the tolerance is held against the headline error.
+    assert "x monolithic" not in text and "largest headline error <= tolerance" in text
+    assert all(r.within_tolerance in ("yes", "no") for r in rows if r.setting == "tolerance")
