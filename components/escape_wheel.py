@@ -2,7 +2,10 @@
 
 The train sends the wheel state and its affine response J_ref phi_dd = T_ref + c_load T_esc;
 the escapement sends its moment T_esc, in affine form T_esc = T_esc_static - J_esc phi_dd
-when its inertia rides on the wheel, and applies impacts as a new wheel speed.
+when its inertia rides on the wheel, and applies impacts as a new wheel speed.  A master
+that steps the escapement first may give the train the escapement moment of that very step
+as its mean and its rate (``T_esc_rate``): the train then takes the step's impulse and its
+first moment, not a held torque.
 """
 
 from __future__ import annotations
@@ -23,6 +26,7 @@ ESCAPE_WHEEL_PORT = {
     "impact_inertia": "J_stot",
     "static_torque": "T_esc_static",
     "load_inertia": "J_esc",
+    "torque_rate": "T_esc_rate",
 }
 
 #: Direct feedthrough of a train: an impact sets the wheel speed at once, and at rest the
@@ -31,8 +35,13 @@ ESCAPE_WHEEL_PORT = {
 IMPACT_INPUTS = ("impact_count", "phi_dot_impact")
 WHEEL_INPUTS = ("T_esc", "T_esc_static", "J_esc", *IMPACT_INPUTS)
 
-#: Mesh forces of both trains (involute and clock): they follow the load at once.
+#: Mesh forces of both trains (involute and clock): they follow the load at once; their
+#: peaks over every internal step are state.
 MESH_FORCE_VARIABLES = (
+    Variable("F12_peak", "output", "N", 0.0, "largest mesh-1 force so far, loaded"),
+    Variable("F23_peak", "output", "N", 0.0, "largest mesh-2 force so far, loaded"),
+    Variable("FF12_peak", "output", "N", 0.0, "largest mesh-1 force so far, unloaded"),
+    Variable("FF23_peak", "output", "N", 0.0, "largest mesh-2 force so far, unloaded"),
     Variable(
         "F12", "output", "N", 0.0, "mesh-1 contact force (any regime)", depends_on=WHEEL_INPUTS
     ),
@@ -74,6 +83,13 @@ ESCAPE_WHEEL_VARIABLES = (
         "kg.m2",
         0.0,
         "escapement inertia at the wheel: the load is T_esc_static - J_esc phi_ddot",
+    ),
+    Variable(
+        "T_esc_rate",
+        "input",
+        "N.m/s",
+        0.0,
+        "the load's rate over the step, about its mean at the step's middle (0: held)",
     ),
     Variable(
         "impact_count",

@@ -31,10 +31,26 @@ class TrainLoadModel:
         self.j_esc = 0.0
         self.stuck = False
         self.t_first_event = -1.0  # first internal event (reversal, stick) in the step
+        #: largest mesh forces at accepted points so far: (F12, F23) loaded, (FF12, FF23)
+        #: unloaded (a tuple: a snapshot's shallow copy restores it)
+        self.peaks = (0.0, 0.0, 0.0, 0.0)
 
     def accel(self, phi: float, phi_dot: float) -> float:
         j, t, c = self.p.response(phi, phi_dot)
         return (t + c * self.t_esc) / (j + c * self.j_esc)
+
+    def accept(self, y: list[float], t: float) -> None:
+        """An accepted internal point: the mesh-force peaks between communication points,
+        which the outputs at step ends miss when steps are long."""
+        if self.stuck:
+            return
+        f12, f23 = self.p.forces(y[0], y[1], self.accel(y[0], y[1]))
+        p12, p23, q12, q23 = self.peaks
+        if self.t_esc != 0.0 or self.j_esc != 0.0:  # loaded: the escapement in contact
+            if f12 > p12 or f23 > p23:
+                self.peaks = (max(p12, f12), max(p23, f23), q12, q23)
+        elif f12 > q12 or f23 > q23:
+            self.peaks = (p12, p23, max(q12, f12), max(q23, f23))
 
     def load(self, phi_ddot: float) -> float:
         """The escapement moment on the wheel at this acceleration."""
@@ -75,6 +91,36 @@ class TrainLoadModel:
         self.p.update_i1r(0.0, self.accel(phi, 0.0))
 
 
+class RampedLoad:
+    """A train model whose held escapement torque ramps over the step: the model as
+    :func:`components.event_integration.advance` sees it, with the torque as a fourth state
+    (it moves at ``rate``), so the train takes an impulse and its first moment."""
+
+    def __init__(self, model: TrainLoadModel, rate: float) -> None:
+        self.model, self.rate = model, rate
+        self.accept = None if getattr(model, "accept", None) is None else self._accept
+
+    @property
+    def halted(self) -> bool:
+        return getattr(self.model, "halted", False)
+
+    def deriv(self, y: list[float]) -> list[float]:
+        self.model.t_esc = y[3]
+        return [*self.model.deriv(y[:3]), self.rate]
+
+    def indicators(self, y: list[float]) -> tuple[float, ...]:
+        self.model.t_esc = y[3]
+        return self.model.indicators(y[:3])
+
+    def event(self, y: list[float], index: int, t: float) -> list[float]:
+        self.model.t_esc = y[3]
+        return [*self.model.event(y[:3], index, t), y[3]]
+
+    def _accept(self, y: list[float], t: float) -> None:
+        self.model.t_esc = y[3]
+        self.model.accept(y[:3], t)
+
+
 class TrainComponent(Component):
     """What every spin-driven train FMU shares: taking impacts and the held escapement load,
     stepping the 1-DOF model with event location, and cheap state snapshots.
@@ -100,6 +146,8 @@ class TrainComponent(Component):
     def _start_integration(self) -> None:
         """The integration accuracy from the parameters (initialize calls it first)."""
         self._control = integration_step_control(self, STATE_SCALES)
+        # The ramped torque is integrated exactly: its scale only keeps the norm defined.
+        self._ramp_control = integration_step_control(self, (*STATE_SCALES, 1.0))
         self._h_next = 0.0
 
     def _apply_inputs(self) -> None:
@@ -124,6 +172,10 @@ class TrainComponent(Component):
         # Direct feedthrough: F12, F23, phi_ddot depend on T_esc; an impact sets phi_dot.
         self._apply_inputs()
         self._outputs()
+        self._peak_outputs()
+
+    def _peak_outputs(self) -> None:
+        self.F12_peak, self.F23_peak, self.FF12_peak, self.FF23_peak = self._model.peaks
 
     def step(self, t: float, h: float) -> None:
         self._apply_inputs()
@@ -133,13 +185,26 @@ class TrainComponent(Component):
         if m.stuck and self._y[1] == 0.0:
             # Held at rest by static friction under held inputs: nothing moves in this step.
             self._outputs()
+            self._peak_outputs()
             return
         # Early return (components.early_return): end at the first event (a mesh piece, a
         # branch, a reversal: each jumps the response the escapement takes).
-        model = UntilFirstEvent(m, t) if self.early_return else m
-        done = advance(model, self._y, h, self._control, self._h_next)
+        rate = self.T_esc_rate if self.J_esc == 0.0 else 0.0
+        if rate == 0.0:
+            model = UntilFirstEvent(m, t) if self.early_return else m
+            done = advance(model, self._y, h, self._control, self._h_next)
+            y = done.y
+        else:
+            # The step's torque from its mean and rate: T_esc(s) = mean + rate (s - h/2).
+            ramped = RampedLoad(m, rate)
+            model = UntilFirstEvent(ramped, t) if self.early_return else ramped
+            y0 = [*self._y, m.t_esc - 0.5 * rate * h]
+            done = advance(model, y0, h, self._ramp_control, self._h_next)
+            y = done.y[:3]
+            m.t_esc = self.T_esc  # the outputs at the step's end: with the inputs held
         self.t_reached = reached(t, h, model)
-        self._y, self._h_next = done.y, done.h_next
+        self._y, self._h_next = y, done.h_next
         if m.t_first_event >= 0.0:
             self.t_event = t + m.t_first_event
         self._outputs()
+        self._peak_outputs()

@@ -913,6 +913,10 @@ class VergeEscapement(Component):
         Variable("T_esc_mean", "output", "N.m", 0.0, "T_esc over the last step, mean"),
         Variable("T_esc_static_mean", "output", "N.m", 0.0, "= T_esc_mean (with J_esc_mean = 0)"),
         Variable("J_esc_mean", "output", "kg.m2", 0.0, "0: the step mean is a plain torque"),
+        # And its rate about the mean at the step's middle, from the angle the wheel took
+        # (the first moment of the torque): 0 as a held signal, the step's as its mean.
+        Variable("T_esc_rate", "output", "N.m/s", 0.0, "0: T_esc is held over a step"),
+        Variable("T_esc_rate_mean", "output", "N.m/s", 0.0, "T_esc's rate over the last step"),
         Variable(
             "phi_ddot",
             "output",
@@ -1063,10 +1067,11 @@ class VergeEscapement(Component):
             self._g_end = core.indicators(y)
             self._outputs(y)
             self.T_esc_mean = self.T_esc_static_mean = self.T_esc
+            self.T_esc_rate_mean = 0.0
             return
         core.budget = int(self.max_internal_steps)
         model = UntilFirstEvent(core, t) if self.early_return else core
-        w0, impacts, coupled = y[1], core.impacts, core.coupled
+        phi0, w0, impacts, coupled = y[0], y[1], core.impacts, core.coupled
         try:
             done = advance(model, y, h, self._control, self._h_next)
         except StepBudgetSpent:
@@ -1089,8 +1094,17 @@ class VergeEscapement(Component):
         held = self._held
         stopped = getattr(model, "stopped_at", -1.0)
         dt = stopped if stopped > 0.0 else h  # the step's length (not a rounded difference)
+        rate = 0.0
         if coupled or core.coupled or core.impacts != impacts:
             mean = (held.j_ref * (w1 - w0) / dt - held.t_ref) / held.c_load
+            if core.impacts == impacts and coupled and core.coupled:
+                # The angle's excess over a constant torque's: J (phi1 - phi0 - w0 dt) =
+                # (T_ref + c mean) dt^2 / 2 - c rate dt^3 / 12 for T = mean + rate (s - dt/2).
+                excess = (
+                    held.j_ref * (y[0] - phi0 - w0 * dt)
+                    - 0.5 * (held.t_ref + held.c_load * mean) * dt * dt
+                )
+                rate = -12.0 * excess / (held.c_load * dt**3)
         else:
             mean = 0.0  # free throughout (an early return ends at the first contact)
         self._y = y
@@ -1099,6 +1113,7 @@ class VergeEscapement(Component):
             core.pn_peak = max(core.pn_peak, core.coupled_terms(y)[4])
         self._outputs(y)
         self.T_esc_mean = self.T_esc_static_mean = mean
+        self.T_esc_rate_mean = rate
 
     def _resync_events(self, y: list[float]) -> list[float]:
         """Fire the events that the jump to the input state crossed (e.g. the tooth is

@@ -330,6 +330,7 @@ TRAIN_SCALES = {
     "T_esc": 0.1,
     "T_esc_static": 0.1,
     "J_esc": 1e-9,
+    "T_esc_rate": 1e3,  # 0.1 N.m over 0.1 ms: the step's ramp, no output takes it
     "phi_dot_impact": 1e3,
     "J_load": 1e-9,
 }

@@ -34,11 +34,14 @@ def test_report_numbers(default_run) -> None:
     assert r.value("FF23_max") / LBF == pytest.approx(2.93, rel=0.02)
     assert r.value("FF12_max") / LBF == pytest.approx(10.94, rel=0.02)
     assert r.value("PN_max") / LBF == pytest.approx(0.66, rel=0.05)
-    # Force peaks against the monolithic model's, taken at its every internal step: the
-    # verge's own peak (PN_peak) does not depend on the communication steps (measured
-    # 2.3e-4; the largest recorded PN alone was 2.9e-2 off under the single pass).
-    for force in ("PN_max", "F23_max", "F12_max"):
-        assert r.accuracy[f"headline_error.{force}"] < 2e-3, force
+    # Force peaks against the monolithic model's, taken at its every internal step.  The
+    # FMUs' own peaks over their internal steps (PN_peak, F*_peak) do not depend on the
+    # communication steps: PN measured 2.5e-6 off (the largest recorded PN alone was 2.9e-2
+    # off under the single pass).  The train's forces follow its load, which the single pass
+    # ramps linearly over a step: F23 2.2e-3, F12 1.2e-3 off.
+    assert r.accuracy["headline_error.PN_max"] < 1e-4
+    for force in ("F23_max", "F12_max", "FF23_max", "FF12_max"):
+        assert r.accuracy[f"headline_error.{force}"] < 5e-3, force
     assert abs(r.value("impacts") - 181) <= 2
 
 
@@ -80,7 +83,7 @@ def test_a_coarse_tolerance_stays_accurate(tmp_path, fmu_cache, default_run) -> 
         assert r.accuracy["trajectory_error"] < 2e-4
         assert r.accuracy["event_time_error"] < 1e-5
     # The single pass (the default here) at 1e-2: the turns error within a tenth of the
-    # tolerance (measured 1.4e-4 to 3.5e-4), in fewer steps than at the scene's.
+    # tolerance (measured 1.1e-5), in fewer steps than at the scene's.
     single = run(tmp_path, fmu_cache, "coarse_single_pass", **{"master.tolerance": 1e-2})
     assert single.stats.extra["input_hold"] == default_run.stats.extra["input_hold"]
     assert single.stats.extra["input_hold"] == "extrapolated"

@@ -37,6 +37,7 @@ from orchestrator.scenes.m739.report import (
     crossing_time,
     escapement_arguments,
     escapement_figure,
+    force_max,
     instance_names,
     pn_max,
     reference_from,
@@ -74,8 +75,7 @@ def analyse(
         out["not_armed_reason"] = {"value": _why_not_armed(scene, col, train), "unit": ""}
     coupled = col[f"{verge}.regime"] != FREE
     for name, mask in (("F23", coupled), ("F12", coupled), ("FF23", ~coupled), ("FF12", ~coupled)):
-        source = col[f"{train}.{name}"]  # F*: coupled motion, FF*: free motion (as the M739's)
-        out[f"{name}_max"] = quantity(float(np.max(source[mask])) if mask.any() else 0.0, "N")
+        out[f"{name}_max"] = quantity(force_max(col, train, name, mask), "N")
     out["PN_max"] = quantity(pn_max(col, verge), "N")
     out["impacts"] = quantity(float(col[f"{verge}.impact_count"][-1]), "1")
     if f"{train}.handovers" in col:

@@ -94,11 +94,20 @@ def analyse(
     regime = col[f"{verge}.regime"]
     coupled = regime != FREE
     for name, mask in (("F23", coupled), ("F12", coupled), ("FF23", ~coupled), ("FF12", ~coupled)):
-        source = col[f"{train}.{name}"]  # F*: coupled motion, FF*: free motion (the report's)
-        out[f"{name}_max"] = quantity(float(np.max(source[mask])) if mask.any() else 0.0, "N")
+        out[f"{name}_max"] = quantity(force_max(col, train, name, mask), "N")
     out["PN_max"] = quantity(pn_max(col, verge), "N")
     out["impacts"] = quantity(float(col[f"{verge}.impact_count"][-1]), "1")
     return out
+
+
+def force_max(col: dict[str, np.ndarray], train: str, name: str, mask: np.ndarray) -> float:
+    """The largest mesh force ``name`` (F*: coupled motion, FF*: free motion, as the
+    report's) over the recorded rows of ``mask``, or the train's own peak over its internal
+    steps (``<name>_peak``) where recorded and larger."""
+    source = col[f"{train}.{name}"]
+    recorded = float(np.max(source[mask])) if mask.any() else 0.0
+    peak = col.get(f"{train}.{name}_peak")
+    return recorded if peak is None else max(recorded, float(peak[-1]))
 
 
 def pn_max(col: dict[str, np.ndarray], verge: str) -> float:
