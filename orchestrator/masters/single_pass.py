@@ -8,7 +8,10 @@ extrapolation from the last exchange point of the same regime (after a regime sw
 first step holds the start values; over an FMU's internal event the slopes go on).  A
 source stepped earlier in the same pass that gives its step mean (an output named after
 the connected one with ``_mean``: the verge's escapement torque whose impulse its wheel
-took) gives that instead, so its receiver takes the very impulse of the step.
+took) gives that instead, so its receiver takes the very impulse of the step; so does its
+rate over the step (``T_esc_rate_mean``, from the angle the wheel took), so the train ramps
+its load and takes the impulse's first moment too (M739's coupling mismatch in the coupled
+phases was 98 % that moment's).
 
 Error.  Where a receiver reports its own copy of a sampled input (an output named after
 the input with ``_own``: the verge's copy of the escape wheel), the estimate is the copy's
