@@ -141,6 +141,14 @@ class ComponentSlave(Fmi2Slave):
         if not math.isfinite(start_time):
             raise self._refuse(f"setupExperiment: start time {start_time} is not finite")
         self._start_time = float(start_time)
+        # A tolerance the host defines is the internal integration's (FMI 2.0, 4.2.4), within
+        # the parameter's range; a value the host then sets for `tolerance` still wins.
+        declared = next((v for v in self.component_class.VARIABLES if v.name == "tolerance"), None)
+        if tolerance is not None and declared is not None and math.isfinite(tolerance):
+            low = declared.min if declared.min is not None else 0.0
+            high = declared.max if declared.max is not None else math.inf
+            self.model.tolerance = min(max(float(tolerance), low), high)
+            self._init_stale = True
 
     def enter_initialization_mode(self) -> None:
         self._initializing = True

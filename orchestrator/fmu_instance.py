@@ -199,11 +199,14 @@ class FmuInstance:
         return self.variables[name].type == "Boolean"
 
     # -- life cycle -------------------------------------------------------------------
-    def initialize(self, start: float, stop: float, values: dict[str, float]) -> None:
-        """Set parameters and input start values, then leave initialization mode."""
+    def initialize(
+        self, start: float, stop: float, values: dict[str, float], tolerance: float | None = None
+    ) -> None:
+        """Set parameters and input start values, then leave initialization mode; a
+        ``tolerance`` is the FMU's own integration tolerance (fmi2SetupExperiment)."""
         logged = len(self.messages)
         try:
-            self.fmu.setupExperiment(startTime=start, stopTime=stop)
+            self.fmu.setupExperiment(tolerance=tolerance, startTime=start, stopTime=stop)
             self.fmu.enterInitializationMode()
             for name, value in values.items():
                 if self.variables[name].type == "Boolean":

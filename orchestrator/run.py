@@ -28,6 +28,7 @@ from orchestrator.execution import execute
 from orchestrator.flight import announce_run
 from orchestrator.fmu_instance import FmuTerminated, file_sha256
 from orchestrator.interrupt import Interrupted, SignalGuard, catching_signals, signal_name
+from orchestrator.masters.regime_aware_choice import fmu_tolerance
 from orchestrator.observers import EnergyBalance
 from orchestrator.output_lock import OutputLock
 from orchestrator.progress import ProgressBar
@@ -133,7 +134,7 @@ def _run_locked(
     start = time.perf_counter()
     try:
         guard.check()
-        system.initialize()
+        system.initialize(fmu_tolerance(system, scene))
         guard.check()
         execute(system, scene, recorder, stats, progress, observers=[energy])
     except FmuTerminated as exc:  # as FMPy does: the run ends there, with what it has

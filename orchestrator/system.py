@@ -155,11 +155,14 @@ class CoupledSystem:
         return slot
 
     # -- life cycle -------------------------------------------------------------------
-    def initialize(self) -> None:
+    def initialize(self, tolerance: float | None = None) -> None:
+        """Instantiate every FMU with its parameters and start values; ``tolerance``: the
+        integration tolerance the master asks of the FMUs (None: their own)."""
         scene = self.scene
         for inst in self.instances:
             spec = scene.fmus[inst.name]
-            inst.initialize(scene.start, scene.stop, {**spec.parameters, **spec.inputs})
+            values = {**spec.parameters, **spec.inputs}
+            inst.initialize(scene.start, scene.stop, values, tolerance)
         # Outputs with direct feedthrough depend on inputs: settle the initial exchange.
         for _ in range(len(self.instances) + 1):
             self.read_all()

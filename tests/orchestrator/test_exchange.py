@@ -1,9 +1,13 @@
-"""Which FMUs the master reads again after setting their inputs: those whose read values
-may depend on them (by the FMU's declared output dependencies)."""
+"""What the master exchanges with the FMUs, and what it spares: it reads again after a feed
+only the FMUs whose read values may depend on their inputs, does not set values an FMU
+holds, and asks the FMUs for an integration tolerance where its scheme controls the
+coupling error (the single pass)."""
 
 from __future__ import annotations
 
 from pathlib import Path
+
+import pytest
 
 from orchestrator.scenario import load_scene
 from orchestrator.system import CoupledSystem
@@ -52,5 +56,49 @@ def test_values_an_fmu_holds_are_not_set_again_until_a_state_is_restored() -> No
         system.feed(i, [2.5])
         assert sets == [[1.5], [2.5], [2.5]]
         system.free_state(state)
+    finally:
+        system.close()
+
+
+def test_the_single_pass_asks_its_fmus_for_a_tolerance_below_its_own() -> None:
+    from orchestrator.masters.regime_aware_choice import fmu_tolerance
+
+    asked = {}
+    for hold in ("auto", "extrapolated", "midpoint"):
+        for tol in (1e-1, 1e-4):
+            scene = load_scene(
+                SCENARIOS / "m739.toml", {"master.input_hold": hold, "master.tolerance": tol}
+            )
+            system = CoupledSystem(scene)
+            try:
+                asked[hold, tol] = fmu_tolerance(system, scene)
+            finally:
+                system.close()
+    assert asked["auto", 1e-1] == asked["extrapolated", 1e-1] == 1e-5  # at most 1e-5
+    assert asked["auto", 1e-4] == pytest.approx(1e-7)
+    assert asked["midpoint", 1e-1] is None and asked["midpoint", 1e-4] is None
+    jacobi = load_scene(SCENARIOS / "m739.toml", {"master.algorithm": "jacobi"})
+    system = CoupledSystem(jacobi)
+    try:
+        assert fmu_tolerance(system, jacobi) is None
+    finally:
+        system.close()
+
+
+def test_a_hosts_tolerance_is_the_fmus_unless_the_parameter_is_set() -> None:
+    scene = load_scene(SCENARIOS / "m739.toml")
+    for given, expected in (({}, 3e-6), ({"tolerance": 1e-9}, 1e-9)):
+        system = CoupledSystem(scene)
+        try:
+            verge = system.instance("verge")
+            verge.initialize(scene.start, scene.stop, given, tolerance=3e-6)
+            assert verge.get("tolerance") == expected
+        finally:
+            system.close()
+    system = CoupledSystem(scene)
+    try:
+        train = system.instance("train")
+        train.initialize(scene.start, scene.stop, {}, tolerance=None)
+        assert train.get("tolerance") == 1e-8  # the FMU's own default
     finally:
         system.close()
