@@ -39,6 +39,8 @@ class Watch:
 class CoupledSystem:
     """FMU instances in master order with their connections and recorded signals."""
 
+    _dependent: list[int] | None = None  # see input_dependent
+
     def __init__(self, scene: Scene, fmu_paths: dict[str, Path] | None = None) -> None:
         """``fmu_paths`` (instance -> FMU file) overrides the files the scene names."""
         self.scene = scene
@@ -131,6 +133,7 @@ class CoupledSystem:
         names = {"int": self.int_names, "bool": self.bool_names, "real": self.real_names}[kind][i]
         if var not in names:
             names.append(var)
+            self._dependent = None  # one more value read: which FMUs to read again may change
         return kind, names.index(var)
 
     def _watch(self, i: int) -> Watch:
@@ -191,11 +194,17 @@ class CoupledSystem:
         output the FMU declares to depend on an input, one it says nothing about, anything
         but an output): those to read again after a feed.  Our crank drive, for one, has
         none: its outputs follow its state."""
-        key = tuple(map(len, self.real_names)), tuple(map(len, self.int_names))
-        if getattr(self, "_dependent_key", None) != key:
-            self._dependent_key = key
+        if self._dependent is None:
             self._dependent = [i for i in range(len(self.names)) if self._reads_feedthrough(i)]
         return self._dependent
+
+    def exchange(self) -> None:
+        """Give every FMU the others' newest outputs and read again those whose read values
+        may depend on their inputs: the values of one consistent instant."""
+        for i in range(len(self.instances)):
+            self.feed(i)
+        for i in self.input_dependent():
+            self.read(i)
 
     def _reads_feedthrough(self, i: int) -> bool:
         model = self.models[i]

@@ -193,7 +193,7 @@ class RegimeAwareMaster:
             states = system.get_state()
             self.kept_states.append(states)
         system.read_all()
-        self.refresh()
+        self.system.exchange()  # indicators of one consistent instant
         self.stats.do_steps += len(which)
         return states
 
@@ -248,15 +248,6 @@ class RegimeAwareMaster:
             if scale > 0.0:
                 worst = max(worst, abs(b - a) / (tol * scale))
         return _Correction(predicted, worst)
-
-    def refresh(self) -> None:
-        """Give every FMU the others' newest outputs, so that outputs which depend on
-        inputs (indicators among them) are those of one consistent instant."""
-        system = self.system
-        for i in range(len(system.instances)):
-            system.feed(i)
-        for i in system.input_dependent():
-            system.read(i)
 
     def switch_time(self, t: float, h: float, before: _Readings) -> _Switch:
         """Earliest switching instant inside (t, t+h], or None if nothing switched.
@@ -321,10 +312,7 @@ class RegimeAwareMaster:
         system = self.system
         for rounds in range(1, self.cfg.max_iterations + 1):
             old = [list(v) for v in system.values], [list(v) for v in system.ints]
-            for i in range(len(system.instances)):
-                system.feed(i)
-            for i in system.input_dependent():
-                system.read(i)
+            system.exchange()
             if (system.values, system.ints) == old:
                 return rounds
         raise RunError(

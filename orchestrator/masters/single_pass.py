@@ -169,15 +169,23 @@ def angles_with_speeds(
     ]
 
 
+def copied_inputs(system: Any) -> list[tuple[tuple[int, int], int, str]]:
+    """The sampled Real inputs whose receiver reports its own copy at the step end (an
+    output named after the input with ``_own``): (source slot, receiver, input name)."""
+    found = []
+    for c, src in zip(system.connections, system.connection_sources, strict=True):
+        j = system.index[c.target[0]]
+        model = system.models[j]
+        if src is not None and c.target[1] in model.sampled:
+            if c.target[1] + OWN_SUFFIX in model.variables:
+                found.append((src, j, c.target[1]))
+    return found
+
+
 def judged_by_copies(system: Any) -> bool:
     """Whether some FMU of the system reports its own copy of a sampled input (the error
     measure the single pass needs to take long steps; ``input_hold = "auto"``)."""
-    for c, src in zip(system.connections, system.connection_sources, strict=True):
-        model = system.models[system.index[c.target[0]]]
-        if src is not None and c.target[1] in model.sampled:
-            if c.target[1] + OWN_SUFFIX in model.variables:
-                return True
-    return False
+    return bool(copied_inputs(system))
 
 
 class SinglePassMaster(RegimeAwareMaster):
@@ -186,9 +194,10 @@ class SinglePassMaster(RegimeAwareMaster):
     def __init__(self, *args: Any, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
         system = self.system
-        averaged = sorted({src for inputs in self.held_inputs for src, avg in inputs if avg})
-        self.extrapolation = InputExtrapolation(averaged)
-        self.averaged = averaged
+        # Every averaged signal is extrapolated (for the feeds); not every one is judged.
+        self.extrapolation = InputExtrapolation(
+            sorted({src for inputs in self.held_inputs for src, avg in inputs if avg})
+        )
         self.first_order = False
         # FMUs that end a step at their first event: set them to do so, stepped first.
         self.early: list[int] = []
@@ -217,16 +226,13 @@ class SinglePassMaster(RegimeAwareMaster):
         # named after the input with "_own"): (source, receiver's copy).  The copy
         # follows the held inputs, the source the true ones: their difference at the step
         # end is the coupling error the next step start discards.
-        self.copies: list[tuple[tuple[int, int], tuple[int, int]]] = []
-        units = []
-        for c, src in zip(system.connections, system.connection_sources, strict=True):
-            j = system.index[c.target[0]]
-            own = c.target[1] + OWN_SUFFIX
-            model = system.models[j]
-            if src is None or c.target[1] not in model.sampled or own not in model.variables:
-                continue
-            self.copies.append((src, (j, system.real_output_slot(j, own))))
-            units.append(model.base_unit(model.variables[c.target[1]].unit))
+        copied = copied_inputs(system)
+        self.copies: list[Copy] = [
+            (src, (j, system.real_output_slot(j, name + OWN_SUFFIX))) for src, j, name in copied
+        ]
+        units = [
+            system.models[j].base_unit(system.models[j].variables[n].unit) for _, j, n in copied
+        ]
         self.judged = angles_with_speeds(self.copies, units)
         # The held inputs of FMUs joined by such a copy are judged by it (their effect on
         # the motion, not the size of their change); the others by their extrapolation.
@@ -249,27 +255,24 @@ class SinglePassMaster(RegimeAwareMaster):
         self.pass_do_steps = 0  # doSteps of the last pass
 
     # -- one pass -----------------------------------------------------------------------
-    def feeds_for(
-        self, h: float, before: _Readings, done: set[int] = frozenset()
-    ) -> list[list[float]]:
-        """Every FMU's Real inputs for a step h from ``before``: held signals at the mean
-        of their extrapolation, sampled ones at their start values, and from a source
-        already stepped over this very step (``done``) that gives its step mean, that."""
+    def feed_row(
+        self, i: int, h: float, before: _Readings, done: set[int] = frozenset()
+    ) -> list[float]:
+        """FMU i's Real inputs for a step h from ``before``: held signals at the mean of
+        their extrapolation, sampled ones at their start values, and from a source already
+        stepped over this very step (``done``) that gives its step mean, that."""
         start, now = before.values, self.system.values
         ex, means = self.extrapolation, self.means
-        feeds = []
-        for inputs in self.held_inputs:
-            row = []
-            for (s, k), averaged in inputs:
-                mean = means.get((s, k)) if s in done else None
-                if mean is not None:
-                    row.append(now[s][mean])
-                elif averaged:
-                    row.append(ex.mean((s, k), start[s][k], h))
-                else:
-                    row.append(start[s][k])
-            feeds.append(row)
-        return feeds
+        row = []
+        for (s, k), averaged in self.held_inputs[i]:
+            mean = means.get((s, k)) if s in done else None
+            if mean is not None:
+                row.append(now[s][mean])
+            elif averaged:
+                row.append(ex.mean((s, k), start[s][k], h))
+            else:
+                row.append(start[s][k])
+        return row
 
     def one_pass(self, t: float, h: float, before: _Readings, state: list[Any]) -> float:
         """Step every FMU once from t, those that end at their first event first (the
@@ -292,7 +295,7 @@ class SinglePassMaster(RegimeAwareMaster):
                 if round_ > 0:
                     system.instances[i].set_state(state[i])
                     self.stats.rollbacks += 1
-                system.feed(i, self.feeds_for(h_end, before, done)[i], before.ints)
+                system.feed(i, self.feed_row(i, h_end, before, done), before.ints)
                 system.step(i, t, h_end)
                 self.stats.do_steps += 1
                 system.read(i)
@@ -307,9 +310,8 @@ class SinglePassMaster(RegimeAwareMaster):
                 # ends there at its event again: it stays among those that returned.
             if not again:
                 break
-        feeds = self.feeds_for(h_end, before, done)
         for i in self.late:
-            system.feed(i, feeds[i], before.ints)
+            system.feed(i, self.feed_row(i, h_end, before, done), before.ints)
             system.step(i, t, h_end)
         self.stats.do_steps += len(self.late)
         for i in self.late:  # the early ones were read after their step
@@ -317,7 +319,7 @@ class SinglePassMaster(RegimeAwareMaster):
         # The values at the step end with the inputs of the step (an impact not yet taken):
         # what the error estimate compares the extrapolation with.
         self.end_values = list(system.values)  # read() replaces the inner lists
-        self.refresh()
+        self.system.exchange()
         self.pass_do_steps = self.stats.do_steps - do_steps
         return h_end
 
