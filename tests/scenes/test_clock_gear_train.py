@@ -355,8 +355,10 @@ def test_sweep_scene_is_the_same_scene_over_the_tolerance_band() -> None:
 
 
 @pytest.mark.slow
-def test_full_arming_run_matches_the_monolithic_reference(tmp_path, fmu_cache) -> None:
-    r = run_scene(load_scene(SCENE), output_dir=tmp_path, cache_dir=fmu_cache, show_progress=False)
+@pytest.mark.parametrize("hold", ["auto", "midpoint"])  # auto: the single pass here
+def test_full_arming_run_matches_the_monolithic_reference(tmp_path, fmu_cache, hold) -> None:
+    scene = load_scene(SCENE, {"master.input_hold": hold})
+    r = run_scene(scene, output_dir=tmp_path, cache_dir=fmu_cache, show_progress=False)
     assert r.status == "completed" and r.value("armed") == 1.0
     acc = r.accuracy
     assert acc["headline_error.turns_to_arm"] < 1e-3
