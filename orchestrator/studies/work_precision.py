@@ -165,20 +165,18 @@ def sweep_jobs(
                 "master.input_hold": "midpoint",
             }
             jobs.append(job(overrides, f"{master}_tol{tol:.0e}", master))
-    for tol in tolerances:
-        overrides = {
-            "master.algorithm": "regime-aware",
-            "master.tolerance": tol,
-            "master.input_hold": "extrapolated",
-        }
-        jobs.append(job(overrides, f"regime-aware-one-pass_tol{tol:.0e}", ONE_PASS))
-    for tol in start_hold_tolerances:
-        overrides = {
-            "master.algorithm": "regime-aware",
-            "master.tolerance": tol,
-            "master.input_hold": "start",
-        }
-        jobs.append(job(overrides, f"regime-aware-start_tol{tol:.0e}", START_HOLD))
+    # The regime-aware master's other schemes, each a line of its own.
+    for hold, label, tols in (
+        ("extrapolated", ONE_PASS, tolerances),
+        ("start", START_HOLD, start_hold_tolerances),
+    ):
+        for tol in tols:
+            overrides = {
+                "master.algorithm": "regime-aware",
+                "master.tolerance": tol,
+                "master.input_hold": hold,
+            }
+            jobs.append(job(overrides, f"{label.replace('/', '-')}_tol{tol:.0e}", label))
     return jobs
 
 
