@@ -82,6 +82,7 @@ from .escape_wheel import (
     IMPACT_INPUTS,
     MESH_FORCE_VARIABLES,
     WHEEL_INPUTS,
+    response_slope_outputs,
 )
 from .event_integration import INTEGRATION_VARIABLES
 from .m739_data import M739, M739Data
@@ -329,6 +330,10 @@ class ClockTrainPhysics:
         ev = self.evaluate(phi)
         return self.i3 + self.i2 * ev[4] * ev[4] + self.i1 * ev[2] * ev[2]
 
+    def impact_inertia(self, phi: float) -> float:
+        """The train's inertia at the wheel for an impact of the verge at phi (B213)."""
+        return self.i_stot
+
     def response(self, phi: float, phi_dot: float) -> tuple[float, float, float]:
         """(J_ref, T_ref, c_load) in the current mode."""
         key = (phi, phi_dot, self.mode_key())
@@ -549,6 +554,7 @@ class ClockGearTrain(TrainComponent):
         Variable("phi_dot_start", "parameter", "rad/s", 0.0, "initial escape-wheel speed"),
         *INTEGRATION_VARIABLES,
         *ESCAPE_WHEEL_VARIABLES,
+        *response_slope_outputs(IMPACT_INPUTS),
         Variable(
             "J_load", "input", "kg.m2", 0.0, "inertia riding on the wheel (handover)", sampled=True
         ),
@@ -633,13 +639,15 @@ class ClockGearTrain(TrainComponent):
     def _outputs(self) -> None:
         p, m = self._phys, self._model
         phi, w, wd = self._y
-        j, tr, c = p.response(phi, w)
+        self._send_response(phi, w)
         acc = 0.0 if m.stuck else m.accel(phi, w)
         ev = p.evaluate(phi)
         self.phi, self.phi_dot, self.phi_ddot = phi, w, acc
-        self.J_ref, self.T_ref, self.c_load = j, tr, c
         p_in, j0, _ = p.power_terms(phi)
         self.J_stot = j0
+        d = 1e-6
+        self.J_stot_phi = (p.j_stot(phi + d) - p.j_stot(phi - d)) / (2 * d)
+        p.evaluate(phi)
         f12, f23 = p.forces(phi, w, acc)
         self.F12, self.F23 = f12, f23
         unloaded = self.T_esc == 0.0

@@ -27,6 +27,10 @@ ESCAPE_WHEEL_PORT = {
     "static_torque": "T_esc_static",
     "load_inertia": "J_esc",
     "torque_rate": "T_esc_rate",
+    "inertia_slope": "J_ref_phi",
+    "drive_slope": "T_ref_phi",
+    "drive_damping": "T_ref_phi_dot",
+    "impact_inertia_slope": "J_stot_phi",
 }
 
 #: Direct feedthrough of a train: an impact sets the wheel speed at once, and at rest the
@@ -34,6 +38,43 @@ ESCAPE_WHEEL_PORT = {
 #: speed, direction or acceleration depends on these inputs within one instant.
 IMPACT_INPUTS = ("impact_count", "phi_dot_impact")
 WHEEL_INPUTS = ("T_esc", "T_esc_static", "J_esc", *IMPACT_INPUTS)
+
+
+def response_slope_outputs(speed_slope_inputs: tuple[str, ...]) -> tuple[Variable, ...]:
+    """The response's slopes in the wheel state at the sent point, in the mode in force:
+    with them the escapement follows J_ref, T_ref and J_stot along its own copy of the wheel
+    over a step (a reduced model of the train), not their values held.  The slopes in the
+    angle follow the mode as J_ref does; the one in the speed depends on the inputs
+    ``speed_slope_inputs`` (a train whose speed slope vanishes at rest in either direction
+    names only the impact inputs)."""
+    return (
+        Variable(
+            "J_ref_phi",
+            "output",
+            "kg.m2/rad",
+            0.0,
+            "slope of J_ref in the wheel angle",
+            depends_on=WHEEL_INPUTS,
+        ),
+        Variable(
+            "T_ref_phi",
+            "output",
+            "N.m/rad",
+            0.0,
+            "slope of T_ref in the wheel angle",
+            depends_on=WHEEL_INPUTS,
+        ),
+        Variable(
+            "T_ref_phi_dot",
+            "output",
+            "N.m.s/rad",
+            0.0,
+            "slope of T_ref in the wheel speed",
+            depends_on=speed_slope_inputs,
+        ),
+        Variable("J_stot_phi", "output", "kg.m2/rad", 0.0, "slope of J_stot in the wheel angle"),
+    )
+
 
 #: Mesh forces of both trains (involute and clock): they follow the load at once; their
 #: peaks over every internal step are state.

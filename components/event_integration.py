@@ -186,12 +186,15 @@ def _dp5_step(
     ]
     k7 = deriv(y1)
     rtol, scales = control.rtol, control.scales
+    # The states past the scales are quadratures (an integral over the step): integrated
+    # with the others, not controlled, so adding them leaves the steps as they were.
+    m = len(scales)
     acc = 0.0
-    for i in rng:
+    for i in range(m):
         e = h * (_E1 * k1[i] + _E3 * k3[i] + _E4 * k4[i] + _E5 * k5[i] + _E6 * k6[i] + _E7 * k7[i])
         sc = rtol * (scales[i] + max(abs(y[i]), abs(y1[i])))
         acc += (e / sc) ** 2
-    err = math.sqrt(acc / n)
+    err = math.sqrt(acc / m)
     if err != err:  # NaN: treat as a failed stage
         raise ArithmeticError("non-finite error estimate")
     dy = [y1[i] - y[i] for i in rng]
@@ -293,7 +296,7 @@ def _restep(
 
 def _first_step(y: list[float], k1: list[float], control: IntegrationStepControl) -> float:
     """A first step from the sizes of y and y' (HNW 1993, II.4, the simple part)."""
-    n = len(y)
+    n = len(control.scales)  # the controlled states (see _dp5_step)
     sc = [control.rtol * (control.scales[i] + abs(y[i])) for i in range(n)]
     d0 = math.sqrt(sum((y[i] / sc[i]) ** 2 for i in range(n)) / n)
     d1 = math.sqrt(sum((k1[i] / sc[i]) ** 2 for i in range(n)) / n)

@@ -52,6 +52,7 @@ from .escape_wheel import (
     IMPACT_INPUTS,
     MESH_FORCE_VARIABLES,
     WHEEL_INPUTS,
+    response_slope_outputs,
 )
 from .event_integration import INTEGRATION_VARIABLES
 from .m739_data import M739, M739Data
@@ -329,6 +330,10 @@ class TrainPhysics:
         t_ref = a15 * f0 - self.t3 * a16
         return j_ref, t_ref, f0, k, a42, a43, a44
 
+    def impact_inertia(self, phi: float) -> float:
+        """The train's inertia at the wheel for an impact of the verge at phi (B213)."""
+        return self.i_stot
+
     def response(self, phi: float, phi_dot: float) -> tuple[float, float, float]:
         """(J_ref, T_ref, c_load) of (*) in the current mode."""
         r = self.parts(phi, phi_dot)
@@ -458,6 +463,7 @@ class GearTrain(TrainComponent):
         Variable("phi_dot_start", "parameter", "rad/s", 0.0, "initial escape-wheel speed"),
         *INTEGRATION_VARIABLES,
         *ESCAPE_WHEEL_VARIABLES,
+        *response_slope_outputs(WHEEL_INPUTS),
         *MESH_FORCE_VARIABLES,
         Variable("rotor_angle", "output", "rad", M739.phi1c, "rotor angle Phi"),
         # The mesh signs follow the direction of motion where the wheel rests on a tooth
@@ -511,10 +517,10 @@ class GearTrain(TrainComponent):
     def _outputs(self) -> None:
         p, m = self._phys, self._model
         phi, w, wd = self._y
-        j, tr, c = p.response(phi, w)
+        self._send_response(phi, w)
         acc = 0.0 if m.stuck else m.accel(phi, w)
         self.phi, self.phi_dot, self.phi_ddot = phi, w, acc
-        self.J_ref, self.T_ref, self.c_load, self.J_stot = j, tr, c, p.i_stot
+        self.J_stot = p.i_stot
         f12, f23 = p.forces(phi, w, acc)
         self.F12, self.F23 = f12, f23
         unloaded = self.T_esc == 0.0

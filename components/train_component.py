@@ -14,6 +14,10 @@ from .event_integration import advance, integration_step_control
 #: Magnitudes below which the integration controls the state [phi, phi_d, W] absolutely:
 #: rad, rad/s, J.
 STATE_SCALES = (1.0, 10.0, 1.0e-3)
+#: Central-difference steps of the response's slopes: rad, and relative to the speed
+#: (at least 1 rad/s).
+SLOPE_STEP_ANGLE = 1.0e-6
+SLOPE_STEP_SPEED = 1.0e-6
 
 
 class TrainLoadModel:
@@ -142,6 +146,23 @@ class TrainComponent(Component):
         m = self._model
         m.j_esc = self.J_esc
         m.t_esc = self.T_esc_static if self.J_esc != 0.0 else self.T_esc
+
+    def _send_response(self, phi: float, phi_dot: float) -> None:
+        """The affine response at the wheel state and its slopes in that state, in the mode
+        in force (central differences: the response is smooth within a mode)."""
+        response = self._phys.response
+        j, t, c = response(phi, phi_dot)
+        self.J_ref, self.T_ref, self.c_load = j, t, c
+        dp = SLOPE_STEP_ANGLE
+        dw = SLOPE_STEP_SPEED * max(1.0, abs(phi_dot))
+        j_hi, t_hi, _ = response(phi + dp, phi_dot)
+        j_lo, t_lo, _ = response(phi - dp, phi_dot)
+        t_fast = response(phi, phi_dot + dw)[1]
+        t_slow = response(phi, phi_dot - dw)[1]
+        response(phi, phi_dot)  # the memo at the state again
+        self.J_ref_phi = (j_hi - j_lo) / (2.0 * dp)
+        self.T_ref_phi = (t_hi - t_lo) / (2.0 * dp)
+        self.T_ref_phi_dot = (t_fast - t_slow) / (2.0 * dw)
 
     def _start_integration(self) -> None:
         """The integration accuracy from the parameters (initialize calls it first)."""

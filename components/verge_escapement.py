@@ -59,6 +59,7 @@ from .early_return import EARLY_RETURN_VARIABLES, UntilFirstEvent, reached
 from .escape_wheel import ESCAPE_WHEEL_PORT
 from .event_integration import INTEGRATION_VARIABLES, advance, integration_step_control
 from .m739_data import M739, M739Data
+from .step_moments import WithMoments
 from .verge_geometry import (
     TWO_PI,
     face_arms,
@@ -293,17 +294,43 @@ def coupled_phi_ddot_b176(
 
 
 class HeldTrain:
-    """The train seen by the verge component: its affine response held over a step."""
+    """The train seen by the verge component: a reduced model of it over a step, its affine
+    response at the wheel state it sent, (phi0, w0), continued by its slopes there (J_ref
+    and J_stot in phi, T_ref in phi and phi_dot; zero slopes hold the response).  Peiret et
+    al., "Co-Simulation of Multibody Systems With Contact Using Reduced Interface Models",
+    J. Comput. Nonlinear Dyn. 15(4) 041001 (2020)."""
 
     def __init__(self, j_ref: float, t_ref: float, c_load: float, i_stot: float) -> None:
         self.j_ref, self.t_ref, self.c_load, self.i_stot = j_ref, t_ref, c_load, i_stot
         self.direction = 1
+        # Slopes of J_ref and T_ref in the wheel state about (phi0, w0), where the train
+        # sent them: the train's reduced model over the step (all 0: the response held).
+        self.j_phi = self.t_phi = self.t_w = self.i_phi = 0.0
+        self.phi0 = self.w0 = 0.0
 
     def response(self, phi: float, phi_dot: float) -> tuple[float, float, float]:
-        return self.j_ref, self.t_ref, self.c_load
+        dp = phi - self.phi0
+        return (
+            self.j_ref + self.j_phi * dp,
+            self.t_ref + self.t_phi * dp + self.t_w * (phi_dot - self.w0),
+            self.c_load,
+        )
+
+    def impact_inertia(self, phi: float) -> float:
+        return self.i_stot + self.i_phi * (phi - self.phi0)
 
     def mode_key(self) -> tuple[float, ...]:
-        return (self.j_ref, self.t_ref, self.c_load, self.direction)
+        return (
+            self.j_ref,
+            self.t_ref,
+            self.c_load,
+            self.direction,
+            self.j_phi,
+            self.t_phi,
+            self.t_w,
+            self.phi0,
+            self.w0,
+        )
 
     def set_direction(self, direction: int, phi: float) -> None:
         self.direction = direction
@@ -332,7 +359,7 @@ class VergeCore:
     """Regime machine and right-hand sides; y = [phi_T, phi_d, psi, psi_d, W_verge].
 
     ``train`` supplies response(phi, phi_d) -> (J_ref, T_ref, c_load), direction,
-    set_direction, mesh_indicators, on_mesh_event, update_i1r and i_stot: either the
+    set_direction, mesh_indicators, on_mesh_event, update_i1r and impact_inertia: either the
     held response (co-simulation component) or the live train physics (monolithic
     reference).
     """
@@ -656,7 +683,7 @@ class VergeCore:
             return y  # separating: stays free (f turns positive again)
         if vc > self.v_capture:
             phi_f, psi_f = impact_map(
-                y[1], y[3], a1p, d1p, self.k.ip, self.train.i_stot, self.k.e_rest
+                y[1], y[3], a1p, d1p, self.k.ip, self.train.impact_inertia(y[0]), self.k.e_rest
             )
             self.impacts += 1
             self._mark(t)
@@ -678,7 +705,8 @@ class VergeCore:
 
     def _impact_loss(self, y: list[float], a1p: float, d1p: float) -> float:
         phi_i, psi_i, phi_f, psi_f = self.last_impact
-        return 0.5 * self.train.i_stot * (phi_i**2 - phi_f**2) + 0.5 * self.k.ip * (
+        j_stot = self.train.impact_inertia(y[0])
+        return 0.5 * j_stot * (phi_i**2 - phi_f**2) + 0.5 * self.k.ip * (
             psi_i**2 - psi_f**2
         )
 
@@ -762,8 +790,12 @@ class VergeEscapement(Component):
     Regime codes: 0 free, 1 coupled on the entrance face, 2 coupled on the exit face.
     At each step the internal copy of the escape-wheel state is taken from the sampled
     inputs (phi, phi_dot); within the step it follows J_ref phi_dd = T_ref + c_load T_esc
-    with the response held.  When ``impact_count`` increments, ``phi_dot_post`` is the
-    escape-wheel speed after the impact, for the train (``GearTrain.phi_dot_impact``),
+    with the response taken at that state and continued by its slopes (``J_ref_phi``,
+    ``T_ref_phi``, ``T_ref_phi_dot``; an impact takes J_stot + ``J_stot_phi`` (phi - phi0)).
+    The torque's impulse over the step and its first moment are integrated with it
+    (``T_esc_mean``, ``T_esc_rate_mean``).  When ``impact_count`` increments,
+    ``phi_dot_post`` is the escape-wheel speed after the impact, for the train
+    (``GearTrain.phi_dot_impact``),
     which takes it at once so that the next phi_dot fed back is the post-impact speed.
     ``t_event`` is the time of the first regime change or impact of the last step that had
     one: a master that steps to events retakes the step with length t_event - t.
@@ -851,10 +883,25 @@ class VergeEscapement(Component):
         ),
         Variable("phi", "input", "rad", 0.0, "cumulative escape-wheel angle", sampled=True),
         Variable("phi_dot", "input", "rad/s", 0.0, "escape-wheel speed", sampled=True),
-        Variable("J_ref", "input", "kg.m2", 2.8e-9, "train effective inertia at the wheel"),
-        Variable("T_ref", "input", "N.m", 0.0, "train net torque at the wheel"),
+        # The train's response at the wheel state sent, with its slopes in that state: the
+        # verge follows it along its own copy of the wheel, so it is taken at the step start.
+        Variable(
+            "J_ref", "input", "kg.m2", 2.8e-9, "train effective inertia at the wheel", sampled=True
+        ),
+        Variable("T_ref", "input", "N.m", 0.0, "train net torque at the wheel", sampled=True),
+        Variable("J_ref_phi", "input", "kg.m2/rad", 0.0, "slope of J_ref in the wheel angle"),
+        Variable("T_ref_phi", "input", "N.m/rad", 0.0, "slope of T_ref in the wheel angle"),
+        Variable("T_ref_phi_dot", "input", "N.m.s/rad", 0.0, "slope of T_ref in the wheel speed"),
         Variable("c_load", "input", "1", 1.0, "train factor on T_esc"),
-        Variable("J_stot", "input", "kg.m2", M739.i_stot, "train inertia for impacts (B213)"),
+        Variable(
+            "J_stot",
+            "input",
+            "kg.m2",
+            M739.i_stot,
+            "train inertia for impacts (B213)",
+            sampled=True,
+        ),
+        Variable("J_stot_phi", "input", "kg.m2/rad", 0.0, "slope of J_stot in the wheel angle"),
         # Direct feedthrough: while coupled the verge follows the wheel angle and speed and
         # the contact force follows the train's response too; free, the gap and the wheel's
         # own acceleration follow the inputs.  J_stot acts only at an impact, in step().
@@ -913,7 +960,7 @@ class VergeEscapement(Component):
         Variable("T_esc_mean", "output", "N.m", 0.0, "T_esc over the last step, mean"),
         Variable("T_esc_static_mean", "output", "N.m", 0.0, "= T_esc_mean (with J_esc_mean = 0)"),
         Variable("J_esc_mean", "output", "kg.m2", 0.0, "0: the step mean is a plain torque"),
-        # And its rate about the mean at the step's middle, from the angle the wheel took
+        # And its rate about the mean at the step's middle, from the torque's first moment
         # (the first moment of the torque): 0 as a held signal, the step's as its mean.
         Variable("T_esc_rate", "output", "N.m/s", 0.0, "0: T_esc is held over a step"),
         Variable("T_esc_rate_mean", "output", "N.m/s", 0.0, "T_esc's rate over the last step"),
@@ -1040,6 +1087,9 @@ class VergeEscapement(Component):
             self.c_load,
             self.J_stot,
         )
+        held.j_phi, held.t_phi, held.t_w = self.J_ref_phi, self.T_ref_phi, self.T_ref_phi_dot
+        held.phi0, held.w0 = self.phi, self.phi_dot
+        held.i_phi = self.J_stot_phi
         if self.phi_dot != 0.0:
             held.direction = _sgn(self.phi_dot)
         y = [self.phi, self.phi_dot, self._y[2], self._y[3], self._y[4]]
@@ -1070,10 +1120,12 @@ class VergeEscapement(Component):
             self.T_esc_rate_mean = 0.0
             return
         core.budget = int(self.max_internal_steps)
-        model = UntilFirstEvent(core, t) if self.early_return else core
-        phi0, w0, impacts, coupled = y[0], y[1], core.impacts, core.coupled
+        # The escapement torque's integral and first moment over the step ride along as
+        # quadratures: a train stepped after the verge takes that impulse and its spread.
+        moments = WithMoments(core, self._torque_at, len(y))
+        model = UntilFirstEvent(moments, t) if self.early_return else moments
         try:
-            done = advance(model, y, h, self._control, self._h_next)
+            done = advance(model, moments.start(y), h, self._control, self._h_next)
         except StepBudgetSpent:
             raise ComponentError(
                 f"VergeEscapement: doStep from t = {t:.9g} s over {h:.6g} s spent its budget of "
@@ -1082,31 +1134,14 @@ class VergeEscapement(Component):
             ) from None
         finally:
             core.budget = None
-        y, self._h_next = done.y, done.h_next
+        y, self._h_next = done.y[: len(y)], done.h_next
         if core.halted:
             raise ComponentError(f"VergeEscapement: {core.fault}")
         if core.t_mark >= 0.0:
             self.t_event = t + core.t_mark
         self.t_reached = reached(t, h, model)
-        # The mean escapement torque on the wheel over the step, from the held response:
-        # J_ref (w1 - w0) = (T_ref + c_load T_esc_mean) dt, w1 just before an impact.
-        w1 = core.last_impact[0] if core.impacts != impacts else y[1]
-        held = self._held
-        stopped = getattr(model, "stopped_at", -1.0)
-        dt = stopped if stopped > 0.0 else h  # the step's length (not a rounded difference)
-        rate = 0.0
-        if coupled or core.coupled or core.impacts != impacts:
-            mean = (held.j_ref * (w1 - w0) / dt - held.t_ref) / held.c_load
-            if core.impacts == impacts and coupled and core.coupled:
-                # The angle's excess over a constant torque's: J (phi1 - phi0 - w0 dt) =
-                # (T_ref + c mean) dt^2 / 2 - c rate dt^3 / 12 for T = mean + rate (s - dt/2).
-                excess = (
-                    held.j_ref * (y[0] - phi0 - w0 * dt)
-                    - 0.5 * (held.t_ref + held.c_load * mean) * dt * dt
-                )
-                rate = -12.0 * excess / (held.c_load * dt**3)
-        else:
-            mean = 0.0  # free throughout (an early return ends at the first contact)
+        # Impacts aside: they reach the train as phi_dot_post.
+        mean, rate = moments.mean_and_rate(done.y)
         self._y = y
         self._g_end = core.indicators(y)
         if core.coupled:  # the step's end is a point of the motion too
@@ -1114,6 +1149,13 @@ class VergeEscapement(Component):
         self._outputs(y)
         self.T_esc_mean = self.T_esc_static_mean = mean
         self.T_esc_rate_mean = rate
+
+    def _torque_at(self, y: list[float]) -> float:
+        """The escapement moment on the wheel at y (none while free or held at rest)."""
+        core = self._core
+        if not core.coupled:
+            return 0.0
+        return core.coupled_terms(y)[5]
 
     def _resync_events(self, y: list[float]) -> list[float]:
         """Fire the events that the jump to the input state crossed (e.g. the tooth is

@@ -9,9 +9,13 @@ first step holds the start values; over an FMU's internal event the slopes go on
 source stepped earlier in the same pass that gives its step mean (an output named after
 the connected one with ``_mean``: the verge's escapement torque whose impulse its wheel
 took) gives that instead, so its receiver takes the very impulse of the step; so does its
-rate over the step (``T_esc_rate_mean``, from the angle the wheel took), so the train ramps
+rate over the step (``T_esc_rate_mean``, from the torque's first moment), so the train ramps
 its load and takes the impulse's first moment too (M739's coupling mismatch in the coupled
-phases was 98 % that moment's).
+phases was 98 % that moment's).  The other way, the train sends its response with its
+slopes in the wheel state (a reduced model of the train, sampled at the step start), so
+the verge's copy of the wheel follows the train over the step rather than held values:
+the copy's mismatch then falls so far that M739's macro steps are bounded by its switches,
+not by the tolerance (2266 doSteps at 1e-2, 2500 at 1e-5).
 
 Error.  Where a receiver reports its own copy of a sampled input (an output named after
 the input with ``_own``: the verge's copy of the escape wheel), the estimate is the copy's

@@ -195,7 +195,7 @@ def test_lists_every_connection_of_each_example(name: str) -> None:
 def test_gear_train_lists_the_m739_connections_with_the_integer_one() -> None:
     assert FMU_RECORDS["GearTrain"].example_paths == ("scenarios/m739.toml",)
     expected = _connection_count("scenarios/m739.toml")
-    assert expected == 12
+    assert expected == 16
     rows = _rows("GearTrain", "connections-m739", "connection")
     assert len(rows) == expected
     links = {r[1] for r in rows}

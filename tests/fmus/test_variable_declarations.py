@@ -221,6 +221,10 @@ def train_states(cls: type[Component]) -> list[tuple[str, Component]]:
     return states
 
 
+#: The train's response slopes the verge takes with the wheel state.
+SLOPES = ("J_ref_phi", "T_ref_phi", "T_ref_phi_dot", "J_stot_phi")
+
+
 def verge_states() -> list[tuple[str, Component]]:
     """At the start (wheel at rest on the entrance face), then from an M739 run exchanging
     the escape-wheel port every microsecond: coupled on the entrance face, free after the
@@ -228,7 +232,7 @@ def verge_states() -> list[tuple[str, Component]]:
     train_cls, verge_cls = component_class("GearTrain"), component_class("VergeEscapement")
     start = initialized(verge_cls, {"T_ref": 1e-2})
     train, verge = initialized(train_cls), verge_cls()
-    wheel = ("phi", "phi_dot", "J_ref", "T_ref", "c_load", "J_stot")
+    wheel = ("phi", "phi_dot", "J_ref", "T_ref", "c_load", "J_stot", *SLOPES)
 
     def exchange() -> None:
         with_inputs(
@@ -287,7 +291,18 @@ FEEDTHROUGH_CASES: dict[str, tuple[Callable[[], list[tuple[str, Component]]], di
     "ClockGearTrain": (lambda: train_states(component_class("ClockGearTrain")), None),
     "VergeEscapement": (
         verge_states,
-        {"phi": 1e-3, "phi_dot": 1e3, "J_ref": 1e-9, "T_ref": 1e-2, "c_load": 0.5, "J_stot": 1e-9},
+        {
+            "phi": 1e-3,
+            "phi_dot": 1e3,
+            "J_ref": 1e-9,
+            "T_ref": 1e-2,
+            "c_load": 0.5,
+            "J_stot": 1e-9,
+            "J_ref_phi": 1e-9,
+            "T_ref_phi": 1e-2,
+            "T_ref_phi_dot": 1e-5,
+            "J_stot_phi": 1e-9,
+        },
     ),
     "CrankCouplerDrive": (
         single(

@@ -164,3 +164,30 @@ def test_press_feed_run3_against_its_reference(press):
     assert acc["trajectory_error"] < 5e-3
     assert acc["event_time_error"] < 1e-4
     assert r.value("energy_residual") < 1e-3
+
+
+@pytest.mark.parametrize(
+    ("scene", "max_error", "max_do_steps"),
+    [
+        ("m739.toml", 3e-6, 2700),
+        pytest.param("clock_train_sa.toml", 2e-5, 5500, marks=pytest.mark.slow),
+    ],
+)
+def test_the_reduced_train_model_makes_steps_follow_switches_not_tolerance(
+    tmp_path, fmu_cache, scene, max_error, max_do_steps
+) -> None:
+    """The train sends its response with its slopes in the wheel state and the verge's copy
+    follows them: the copy's mismatch is so small that the passes are bounded by the
+    switches.  Counted (doSteps) and against the monolithic model at tolerance 1e-10:
+    M739 2266 / 2500 doSteps, turns error 1.7e-6 / 2.8e-8 at 1e-2 / 1e-5; the clock train
+    2467 / 5238 doSteps, 1.4e-5 / 6.7e-6 (every error within its tolerance)."""
+    from orchestrator.scenes.clock_train.monolithic import run_clock_train
+    from orchestrator.scenes.m739.monolithic import run_m739
+
+    monolithic = run_m739 if scene == "m739.toml" else run_clock_train
+    truth = monolithic(tolerance=1e-10).turns
+    for tol in (1e-2, 1e-5):
+        r = run(tmp_path / str(tol), fmu_cache, scene, reference=False, **{"master.tolerance": tol})
+        error = abs(r.value("turns_to_arm") - truth) / truth
+        assert error <= min(tol, max_error), (tol, error)
+        assert r.stats.do_steps <= max_do_steps, (tol, r.stats.do_steps)
