@@ -706,9 +706,7 @@ class VergeCore:
     def _impact_loss(self, y: list[float], a1p: float, d1p: float) -> float:
         phi_i, psi_i, phi_f, psi_f = self.last_impact
         j_stot = self.train.impact_inertia(y[0])
-        return 0.5 * j_stot * (phi_i**2 - phi_f**2) + 0.5 * self.k.ip * (
-            psi_i**2 - psi_f**2
-        )
+        return 0.5 * j_stot * (phi_i**2 - phi_f**2) + 0.5 * self.k.ip * (psi_i**2 - psi_f**2)
 
     def _enter_coupled(self, y: list[float], t: float) -> list[float]:
         new = COUPLED_ENTRANCE if self.face == ENTRANCE else COUPLED_EXIT
