@@ -120,7 +120,8 @@ class ClockTrainPhysics:
     k, phase and sliding sign, and the sign sigma of each mesh normal force.  The interface is
     the one ``components.verge_escapement.VergeCore`` expects of a live train (``response``,
     ``direction``, ``set_direction``, ``mesh_indicators``, ``on_mesh_event``, ``update_i1r``,
-    ``i_stot``, ``mode_key``, ``forces``), so the monolithic reference reuses the verge.
+    ``impact_inertia``, ``mode_key``, ``forces``), so the monolithic reference reuses the
+    verge.
     """
 
     def __init__(
@@ -172,7 +173,6 @@ class ClockTrainPhysics:
         self.eta_cycle = self._cycle_efficiencies() if self.loss_model == LOSS_CYCLE else None
         self.set_mode(0.0, 1)
         self.theta1_0 = self.evaluate(0.0)[0]
-        self.i_stot = self.j_stot(0.0)
 
     # -- mode -------------------------------------------------------------------------------
     def mode_key(self) -> tuple[Any, ...]:
@@ -331,8 +331,9 @@ class ClockTrainPhysics:
         return self.i3 + self.i2 * ev[4] * ev[4] + self.i1 * ev[2] * ev[2]
 
     def impact_inertia(self, phi: float) -> float:
-        """The train's inertia at the wheel for an impact of the verge at phi (B213)."""
-        return self.i_stot
+        """The train's inertia at the wheel for an impact of the verge at phi (B213): the
+        frictionless reflected inertia there, which ripples with the tooth ratio."""
+        return self.j_stot(phi)
 
     def response(self, phi: float, phi_dot: float) -> tuple[float, float, float]:
         """(J_ref, T_ref, c_load) in the current mode."""
@@ -444,10 +445,6 @@ class ClockTrainPhysics:
     def evaluate_phi(self) -> float:
         """The position of the last kinematic evaluation."""
         return self._memo[0][0] if self._memo is not None else 0.0
-
-    def locate(self, phi: float) -> None:
-        """Evaluate at phi (sets ``i_stot`` for an impact of the verge there)."""
-        self.i_stot = self.j_stot(phi)
 
 
 # ------------------------------------------------------------------------------------------
@@ -644,10 +641,6 @@ class ClockGearTrain(TrainComponent):
         ev = p.evaluate(phi)
         self.phi, self.phi_dot, self.phi_ddot = phi, w, acc
         p_in, j0, _ = p.power_terms(phi)
-        self.J_stot = j0
-        d = 1e-6
-        self.J_stot_phi = (p.j_stot(phi + d) - p.j_stot(phi - d)) / (2 * d)
-        p.evaluate(phi)
         f12, f23 = p.forces(phi, w, acc)
         self.F12, self.F23 = f12, f23
         unloaded = self.T_esc == 0.0

@@ -520,7 +520,6 @@ class GearTrain(TrainComponent):
         self._send_response(phi, w)
         acc = 0.0 if m.stuck else m.accel(phi, w)
         self.phi, self.phi_dot, self.phi_ddot = phi, w, acc
-        self.J_stot = p.i_stot
         f12, f23 = p.forces(phi, w, acc)
         self.F12, self.F23 = f12, f23
         unloaded = self.T_esc == 0.0

@@ -7,38 +7,23 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
+from .augmented_model import AugmentedModel
 
-class WithMoments:
-    """``model`` as :func:`components.event_integration.advance` sees it, with three states
-    appended: the time since the step start s, the integral of ``value`` over the step and
-    that of s times it.  An event leaves them as they are."""
+
+class WithMoments(AugmentedModel):
+    """``model`` with three states appended: the time since the step start s, the integral
+    of ``value`` over the step and that of s times it."""
 
     def __init__(self, model: Any, value: Callable[[list[float]], float], n: int) -> None:
-        self.model, self.value, self.n = model, value, n
-        self.accept = None if getattr(model, "accept", None) is None else self._accept
-
-    @property
-    def halted(self) -> bool:
-        return getattr(self.model, "halted", False)
+        super().__init__(model, n)
+        self.value = value
 
     def start(self, y: list[float]) -> list[float]:
         return [*y, 0.0, 0.0, 0.0]
 
-    def deriv(self, y: list[float]) -> list[float]:
-        n = self.n
-        d = self.model.deriv(y[:n])
-        v = self.value(y[:n])
-        return [*d, 1.0, v, y[n] * v]
-
-    def indicators(self, y: list[float]) -> tuple[float, ...]:
-        return self.model.indicators(y[: self.n])
-
-    def event(self, y: list[float], index: int, t: float) -> list[float]:
-        n = self.n
-        return [*self.model.event(y[:n], index, t), *y[n:]]
-
-    def _accept(self, y: list[float], t: float) -> None:
-        self.model.accept(y[: self.n], t)
+    def extra_deriv(self, y: list[float], own: list[float]) -> list[float]:
+        v = self.value(own)
+        return [1.0, v, y[self.n] * v]
 
     def mean_and_rate(self, y: list[float]) -> tuple[float, float]:
         """The value's mean over the step that ended at y and its rate about the step's

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from typing import Any
 
+from .augmented_model import AugmentedModel
 from .base import Component, SnapshotPlan
 from .early_return import UntilFirstEvent, reached
 from .event_integration import advance, integration_step_control
@@ -95,34 +96,19 @@ class TrainLoadModel:
         self.p.update_i1r(0.0, self.accel(phi, 0.0))
 
 
-class RampedLoad:
-    """A train model whose held escapement torque ramps over the step: the model as
-    :func:`components.event_integration.advance` sees it, with the torque as a fourth state
-    (it moves at ``rate``), so the train takes an impulse and its first moment."""
+class RampedLoad(AugmentedModel):
+    """A train model whose held escapement torque ramps over the step, the torque a fourth
+    state moving at ``rate``: the train takes an impulse and its first moment."""
 
     def __init__(self, model: TrainLoadModel, rate: float) -> None:
-        self.model, self.rate = model, rate
-        self.accept = None if getattr(model, "accept", None) is None else self._accept
+        super().__init__(model, 3)
+        self.rate = rate
 
-    @property
-    def halted(self) -> bool:
-        return getattr(self.model, "halted", False)
-
-    def deriv(self, y: list[float]) -> list[float]:
+    def enter(self, y: list[float]) -> None:
         self.model.t_esc = y[3]
-        return [*self.model.deriv(y[:3]), self.rate]
 
-    def indicators(self, y: list[float]) -> tuple[float, ...]:
-        self.model.t_esc = y[3]
-        return self.model.indicators(y[:3])
-
-    def event(self, y: list[float], index: int, t: float) -> list[float]:
-        self.model.t_esc = y[3]
-        return [*self.model.event(y[:3], index, t), y[3]]
-
-    def _accept(self, y: list[float], t: float) -> None:
-        self.model.t_esc = y[3]
-        self.model.accept(y[:3], t)
+    def extra_deriv(self, y: list[float], own: list[float]) -> list[float]:
+        return [self.rate]
 
 
 class TrainComponent(Component):
@@ -148,21 +134,24 @@ class TrainComponent(Component):
         m.t_esc = self.T_esc_static if self.J_esc != 0.0 else self.T_esc
 
     def _send_response(self, phi: float, phi_dot: float) -> None:
-        """The affine response at the wheel state and its slopes in that state, in the mode
-        in force (central differences: the response is smooth within a mode)."""
-        response = self._phys.response
-        j, t, c = response(phi, phi_dot)
-        self.J_ref, self.T_ref, self.c_load = j, t, c
+        """The affine response and the impact inertia at the wheel state, with their slopes
+        in that state in the mode in force (central differences: smooth within a mode).
+        The evaluations off the state come first: the physics remembers its last point
+        (the friction branches read it), which ends at the state."""
+        p = self._phys
         dp = SLOPE_STEP_ANGLE
         dw = SLOPE_STEP_SPEED * max(1.0, abs(phi_dot))
-        j_hi, t_hi, _ = response(phi + dp, phi_dot)
-        j_lo, t_lo, _ = response(phi - dp, phi_dot)
-        t_fast = response(phi, phi_dot + dw)[1]
-        t_slow = response(phi, phi_dot - dw)[1]
-        response(phi, phi_dot)  # the memo at the state again
+        j_hi, t_hi, _ = p.response(phi + dp, phi_dot)
+        j_lo, t_lo, _ = p.response(phi - dp, phi_dot)
+        i_hi, i_lo = p.impact_inertia(phi + dp), p.impact_inertia(phi - dp)
+        t_fast = p.response(phi, phi_dot + dw)[1]
+        t_slow = p.response(phi, phi_dot - dw)[1]
+        self.J_ref, self.T_ref, self.c_load = p.response(phi, phi_dot)
+        self.J_stot = p.impact_inertia(phi)
         self.J_ref_phi = (j_hi - j_lo) / (2.0 * dp)
         self.T_ref_phi = (t_hi - t_lo) / (2.0 * dp)
         self.T_ref_phi_dot = (t_fast - t_slow) / (2.0 * dw)
+        self.J_stot_phi = (i_hi - i_lo) / (2.0 * dp)
 
     def _start_integration(self) -> None:
         """The integration accuracy from the parameters (initialize calls it first)."""

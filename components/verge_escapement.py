@@ -303,8 +303,8 @@ class HeldTrain:
     def __init__(self, j_ref: float, t_ref: float, c_load: float, i_stot: float) -> None:
         self.j_ref, self.t_ref, self.c_load, self.i_stot = j_ref, t_ref, c_load, i_stot
         self.direction = 1
-        # Slopes of J_ref and T_ref in the wheel state about (phi0, w0), where the train
-        # sent them: the train's reduced model over the step (all 0: the response held).
+        # Slopes of J_ref, T_ref and J_stot in the wheel state about (phi0, w0), where the
+        # train sent them: its reduced model over the step (all 0: the response held).
         self.j_phi = self.t_phi = self.t_w = self.i_phi = 0.0
         self.phi0 = self.w0 = 0.0
 
@@ -958,8 +958,8 @@ class VergeEscapement(Component):
         Variable("T_esc_mean", "output", "N.m", 0.0, "T_esc over the last step, mean"),
         Variable("T_esc_static_mean", "output", "N.m", 0.0, "= T_esc_mean (with J_esc_mean = 0)"),
         Variable("J_esc_mean", "output", "kg.m2", 0.0, "0: the step mean is a plain torque"),
-        # And its rate about the mean at the step's middle, from the torque's first moment
-        # (the first moment of the torque): 0 as a held signal, the step's as its mean.
+        # And its rate about the mean at the step's middle, from the torque's first moment:
+        # 0 as a held signal, the step's as its mean.
         Variable("T_esc_rate", "output", "N.m/s", 0.0, "0: T_esc is held over a step"),
         Variable("T_esc_rate_mean", "output", "N.m/s", 0.0, "T_esc's rate over the last step"),
         Variable(
@@ -1149,7 +1149,7 @@ class VergeEscapement(Component):
         self.T_esc_rate_mean = rate
 
     def _torque_at(self, y: list[float]) -> float:
-        """The escapement moment on the wheel at y (none while free or held at rest)."""
+        """The escapement moment on the wheel at y (none while free)."""
         core = self._core
         if not core.coupled:
             return 0.0

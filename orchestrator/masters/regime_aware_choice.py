@@ -34,13 +34,7 @@ def regime_aware(system: CoupledSystem, scene: Scene, stats: StepStats) -> Maste
             "at communication points)"
         )
         return fixed_step_master(system, scene, stats, scene.master.step, sequential=False)
-    settings = scene.master.settings
-    if settings.input_hold == "auto":
-        # The single pass where an FMU's copy of its partner judges the coupling; elsewhere
-        # its error test holds steps near the stiffest coupling's stability limit (press
-        # feed Run 1 at 1e-3: 4.8x its reference, the midpoint hold 2.2x).
-        hold = "extrapolated" if judged_by_copies(system) else "midpoint"
-        settings = replace(settings, input_hold=hold)
+    settings = replace(scene.master.settings, input_hold=input_hold(system, scene))
     stats.extra["input_hold"] = settings.input_hold
     algorithm = SinglePassMaster if settings.single_pass else RegimeAwareMaster
     return algorithm(system, settings, stats)
@@ -61,7 +55,17 @@ def fmu_tolerance(system: CoupledSystem, scene: Scene) -> float | None:
     settings = scene.master.settings
     if scene.master.algorithm != "regime-aware" or settings is None:
         return None
-    hold = settings.input_hold
-    if hold == "extrapolated" or (hold == "auto" and judged_by_copies(system)):
+    if input_hold(system, scene) == "extrapolated":
         return min(FMU_TOLERANCE_MAX, FMU_TOLERANCE_FRACTION * settings.tolerance)
     return None
+
+
+def input_hold(system: CoupledSystem, scene: Scene) -> str:
+    """The regime-aware master's ``input_hold`` with "auto" resolved: the single pass
+    ("extrapolated") where an FMU's copy of its partner judges the coupling; elsewhere the
+    midpoint hold, as the single pass's error test holds steps near the stiffest coupling's
+    stability limit (press feed Run 1 at 1e-3: 4.8x its reference, the midpoint hold 2.2x)."""
+    hold = scene.master.settings.input_hold
+    if hold != "auto":
+        return hold
+    return "extrapolated" if judged_by_copies(system) else "midpoint"

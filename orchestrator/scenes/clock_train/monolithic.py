@@ -36,7 +36,6 @@ class _ClockMonolithic(VergeTrainMonolithic):
 
     def event(self, y: list[float], index: int, t: float) -> list[float]:
         tr = self.train
-        tr.locate(y[0])  # reflected inertia at this point, for an impact of the verge
         if index not in (IND_MESH_HI, IND_MESH_LO):
             return super().event(y, index, t)
         j_load = 0.0
