@@ -136,8 +136,20 @@ class TrainComponent(Component):
     def _send_response(self, phi: float, phi_dot: float) -> None:
         """The affine response and the impact inertia at the wheel state, with their slopes
         in that state in the mode in force (central differences: smooth within a mode).
-        The evaluations off the state come first: the physics remembers its last point
-        (the friction branches read it), which ends at the state."""
+        The slopes of the last state and mode are kept: the outputs after a step and
+        those after the exchange that follows ask at the same point."""
+        p = self._phys
+        key = (phi, phi_dot, p.mode_key())
+        if key != self._slopes_at:
+            self._slopes, self._slopes_at = self._slopes_of(phi, phi_dot), key
+        self.J_ref_phi, self.T_ref_phi, self.T_ref_phi_dot, self.J_stot_phi = self._slopes
+        self.J_ref, self.T_ref, self.c_load = p.response(phi, phi_dot)
+        self.J_stot = p.impact_inertia(phi)
+
+    def _slopes_of(self, phi: float, phi_dot: float) -> tuple[float, float, float, float]:
+        """(J_ref, T_ref in phi; T_ref in phi_dot; J_stot in phi).  The evaluations in the
+        speed come last: the physics remembers its last point (the friction branches read
+        it), which so ends at the state."""
         p = self._phys
         dp = SLOPE_STEP_ANGLE
         dw = SLOPE_STEP_SPEED * max(1.0, abs(phi_dot))
@@ -146,12 +158,12 @@ class TrainComponent(Component):
         i_hi, i_lo = p.impact_inertia(phi + dp), p.impact_inertia(phi - dp)
         t_fast = p.response(phi, phi_dot + dw)[1]
         t_slow = p.response(phi, phi_dot - dw)[1]
-        self.J_ref, self.T_ref, self.c_load = p.response(phi, phi_dot)
-        self.J_stot = p.impact_inertia(phi)
-        self.J_ref_phi = (j_hi - j_lo) / (2.0 * dp)
-        self.T_ref_phi = (t_hi - t_lo) / (2.0 * dp)
-        self.T_ref_phi_dot = (t_fast - t_slow) / (2.0 * dw)
-        self.J_stot_phi = (i_hi - i_lo) / (2.0 * dp)
+        return (
+            (j_hi - j_lo) / (2.0 * dp),
+            (t_hi - t_lo) / (2.0 * dp),
+            (t_fast - t_slow) / (2.0 * dw),
+            (i_hi - i_lo) / (2.0 * dp),
+        )
 
     def _start_integration(self) -> None:
         """The integration accuracy from the parameters (initialize calls it first)."""
@@ -159,6 +171,8 @@ class TrainComponent(Component):
         # The ramped torque is integrated exactly: its scale only keeps the norm defined.
         self._ramp_control = integration_step_control(self, (*STATE_SCALES, 1.0))
         self._h_next = 0.0
+        self._slopes_at: tuple = ()  # the state and mode of the slopes kept (_send_response)
+        self._slopes = (0.0, 0.0, 0.0, 0.0)
 
     def _apply_inputs(self) -> None:
         """Take a new impact speed (once per impact_count change) and the held load.
