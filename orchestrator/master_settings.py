@@ -113,7 +113,8 @@ class RegimeAwareSettings:
     tolerance: float = setting(1e-4, "1")  # coupling error per step, relative to scale
     event_tolerance: float = setting(1e-10, "s")  # how closely a step lands on a switch
     min_step: float = setting(1e-14, "s")
-    max_step: float = setting(None, "s")  # default: 100 first steps, at most the run
+    # default: 100 first steps, at most the run (the single pass: the run)
+    max_step: float = setting(None, "s")
     max_iterations: int = setting(10)  # exchange rounds at a switching instant
     max_events_per_step: int = setting(50)  # switches at (nearly) one instant: chattering
     input_hold: str = setting("auto", choices=("auto", "start", "midpoint", "extrapolated"))

@@ -169,8 +169,8 @@ def test_press_feed_run3_against_its_reference(press):
 @pytest.mark.parametrize(
     ("scene", "max_error", "max_do_steps"),
     [
-        ("m739.toml", 3e-6, 2700),
-        pytest.param("clock_train_sa.toml", 2e-5, 5500, marks=pytest.mark.slow),
+        ("m739.toml", 1e-4, 2100),
+        pytest.param("clock_train_sa.toml", 1e-4, 5500, marks=pytest.mark.slow),
     ],
 )
 def test_the_reduced_train_model_makes_steps_follow_switches_not_tolerance(
@@ -178,9 +178,11 @@ def test_the_reduced_train_model_makes_steps_follow_switches_not_tolerance(
 ) -> None:
     """The train sends its response with its slopes in the wheel state and the verge's copy
     follows them: the copy's mismatch is so small that the passes are bounded by the
-    switches.  Counted (doSteps) and against the monolithic model at tolerance 1e-10:
-    M739 2266 / 2500 doSteps, turns error 1.7e-6 / 2.8e-8 at 1e-2 / 1e-5; the clock train
-    2467 / 5238 doSteps, 1.4e-5 / 6.7e-6 (every error within its tolerance)."""
+    switches.  Counted (doSteps) and against the monolithic model at tolerance 1e-10, with
+    no longest step but the run (the single pass's default): M739 1334 / 2010 doSteps,
+    turns error 7.5e-5 / 8.0e-7 at 1e-2 / 1e-5; the clock train 1737 / 5237 doSteps,
+    8.4e-5 / 6.7e-6 (every error within its tolerance and within the 1e-4 the speed
+    targets ask)."""
     from orchestrator.scenes.clock_train.monolithic import run_clock_train
     from orchestrator.scenes.m739.monolithic import run_m739
 
