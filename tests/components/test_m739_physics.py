@@ -577,3 +577,18 @@ def test_components_state_roundtrip_bit_identical():
         out2.append(m.outputs())
     assert out1 == out2
     assert len({o[7] for o in out1}) >= 2  # the window covers a regime change
+
+
+def test_the_normal_force_peak_between_accepted_points_is_the_parabolas_vertex() -> None:
+    """A peak between internal points is not missed by the square of the step."""
+    from components.verge_escapement import _vertex
+
+    def force(t: float) -> float:
+        return 3.0 - 2.0 * (t - 0.4) ** 2
+
+    points = [(t, force(t)) for t in (0.0, 0.5, 1.2)]
+    assert max(p for _, p in points) < 2.99  # the accepted points alone
+    assert _vertex(*points) == pytest.approx(3.0, rel=1e-14)
+    # Rising or falling through the middle point, or not spanning time: no vertex.
+    assert _vertex((0.0, 1.0), (0.5, 2.0), (1.0, 3.0)) == -math.inf
+    assert _vertex((0.0, 1.0), (0.0, 2.0), (1.0, 1.0)) == -math.inf
