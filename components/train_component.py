@@ -153,9 +153,9 @@ class TrainComponent(Component):
         p = self._phys
         dp = SLOPE_STEP_ANGLE
         dw = SLOPE_STEP_SPEED * max(1.0, abs(phi_dot))
-        j_hi, t_hi, _ = p.response(phi + dp, phi_dot)
-        j_lo, t_lo, _ = p.response(phi - dp, phi_dot)
-        i_hi, i_lo = p.impact_inertia(phi + dp), p.impact_inertia(phi - dp)
+        # Each angle's two quantities together: the physics keeps its kinematics at one angle.
+        (j_hi, t_hi, _), i_hi = p.response(phi + dp, phi_dot), p.impact_inertia(phi + dp)
+        (j_lo, t_lo, _), i_lo = p.response(phi - dp, phi_dot), p.impact_inertia(phi - dp)
         t_fast = p.response(phi, phi_dot + dw)[1]
         t_slow = p.response(phi, phi_dot - dw)[1]
         return (
