@@ -46,8 +46,9 @@ def single_pass_max_step(scene: Scene) -> float:
     """The single pass's longest step where the scene sets none: the run.  Its steps end at
     the first event of an FMU that returns early and are held to the tolerance by the copies'
     mismatch, so a cap tied to master.first_step only adds passes (M739 at 1e-3: 1377
-    doSteps and turns error 8.6e-6, against 2266 and 2.4e-6 at the midpoint hold's 100
-    first steps; the clock train 2055 against 2467, 5.7e-5 against 9.5e-6)."""
+    doSteps and turns error 8.6e-6, against 2266 and 2.4e-6 capped at 100 first steps, the
+    midpoint hold's default; the clock train 2055 and 5.7e-5 against 2467 and 9.5e-6).  A
+    scene's own master.max_step still wins."""
     return scene.stop - scene.start
 
 

@@ -15,7 +15,8 @@ phases was 98 % that moment's).  The other way, the train sends its response wit
 slopes in the wheel state (a reduced model of the train, sampled at the step start), so
 the verge's copy of the wheel follows the train over the step rather than held values:
 the copy's mismatch then falls so far that M739's macro steps are bounded by its switches,
-not by the tolerance (2266 doSteps at 1e-2, 2500 at 1e-5).
+not by the tolerance (1334 doSteps at 1e-2, 2010 at 1e-5; no longest step but the run
+unless the scene sets one: ``regime_aware_choice.single_pass_max_step``).
 
 Error.  Where a receiver reports its own copy of a sampled input (an output named after
 the input with ``_own``: the verge's copy of the escape wheel), the estimate is the copy's
