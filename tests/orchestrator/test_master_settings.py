@@ -137,3 +137,26 @@ def test_auto_input_hold_picks_the_single_pass_where_a_copy_judges_the_coupling(
         )
         chosen[name] = r.stats.extra["input_hold"]
     assert chosen == {"m739": "extrapolated", "two": "midpoint"}
+
+
+@pytest.mark.parametrize(
+    ("overrides", "longest"),
+    [
+        ({}, 0.2),  # the single pass: the run (scene.stop 0.2 s)
+        ({"master.max_step": "50 us"}, 50e-6),  # the scene's own wins
+        ({"master.input_hold": "midpoint"}, 100e-6),  # the midpoint hold: 100 first steps
+    ],
+)
+def test_the_single_pass_takes_no_longest_step_of_its_own(overrides: dict, longest: float) -> None:
+    from orchestrator.masters.regime_aware_choice import fmu_tolerance, regime_aware
+    from orchestrator.recorder import StepStats
+    from orchestrator.system import CoupledSystem
+
+    scene = load_scene(M739, overrides)
+    system = CoupledSystem(scene)
+    try:
+        system.initialize(fmu_tolerance(system, scene))
+        master = regime_aware(system, scene, StepStats())
+        assert master.cfg.max_step == pytest.approx(longest, rel=1e-12)
+    finally:
+        system.close()
