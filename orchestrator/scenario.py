@@ -667,7 +667,7 @@ class _Loader:
             settings = master_settings(algorithm, step, duration, options)
         except SettingError as exc:
             raise self.fail(f"master.{exc.key}", str(exc)) from None
-        largest = getattr(settings, "max_step", None)  # a master that varies its step
+        largest = getattr(settings, "longest_step", None)  # a master that varies its step
         if largest is None and duration / step > MAX_STEPS and not self.force:
             raise self.fail(
                 used_key,

@@ -348,7 +348,7 @@ class RegimeAwareMaster:
         if te is None:
             ratio, first_order = accepted.estimate
             self._note_changes(before)
-            self.h = min(cfg.max_step, h * control.grow(ratio, first_order))
+            self.h = min(cfg.longest_step, h * control.grow(ratio, first_order))
             self._remember_step(tuple(before.regimes), ratio, self.h)
             self.same_instant = 0
             # A regime that changed without a located switch changed at the step start.
@@ -391,7 +391,7 @@ class RegimeAwareMaster:
         """The first step after a switch into ``regimes``: master.first_step, or where the
         coupling error has been exactly zero, a fraction of the step proposed there."""
         remembered = self.zero_error_step.get(regimes, 0.0) * self.control.zero_error_restart
-        return max(self.cfg.first_step, remembered)  # remembered steps are <= max_step
+        return max(self.cfg.first_step, remembered)  # remembered steps are <= longest_step
 
     def _attempt(self, t: float, h: float, before: _Readings, state: list[Any]) -> _Accepted:
         """Trial steps from t until one is accepted.

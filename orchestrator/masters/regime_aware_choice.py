@@ -35,21 +35,9 @@ def regime_aware(system: CoupledSystem, scene: Scene, stats: StepStats) -> Maste
         )
         return fixed_step_master(system, scene, stats, scene.master.step, sequential=False)
     settings = replace(scene.master.settings, input_hold=input_hold(system, scene))
-    if settings.single_pass and "max_step" not in scene.master.options:
-        settings = replace(settings, max_step=single_pass_max_step(scene))
     stats.extra["input_hold"] = settings.input_hold
     algorithm = SinglePassMaster if settings.single_pass else RegimeAwareMaster
     return algorithm(system, settings, stats)
-
-
-def single_pass_max_step(scene: Scene) -> float:
-    """The single pass's longest step where the scene sets none: the run.  Its steps end at
-    the first event of an FMU that returns early and are held to the tolerance by the copies'
-    mismatch, so a cap tied to master.first_step only adds passes (M739 at 1e-3: 1377
-    doSteps and turns error 8.6e-6, against 2266 and 2.4e-6 capped at 100 first steps, the
-    midpoint hold's default; the clock train 2055 and 5.7e-5 against 2467 and 9.5e-6).  A
-    scene's own master.max_step still wins."""
-    return scene.stop - scene.start
 
 
 #: The single pass asks its FMUs for this fraction of its own tolerance, at most

@@ -16,7 +16,7 @@ slopes in the wheel state (a reduced model of the train, sampled at the step sta
 the verge's copy of the wheel follows the train over the step rather than held values:
 the copy's mismatch then falls so far that M739's macro steps are bounded by its switches,
 not by the tolerance (1334 doSteps at 1e-2, 2010 at 1e-5; no longest step but the run
-unless the scene sets one: ``regime_aware_choice.single_pass_max_step``).
+unless the scene sets one: ``RegimeAwareSettings.longest_step``).
 
 Error.  Where a receiver reports its own copy of a sampled input (an output named after
 the input with ``_own``: the verge's copy of the escape wheel), the estimate is the copy's
@@ -390,7 +390,7 @@ class SinglePassMaster(RegimeAwareMaster):
         if te is None:
             self.extrapolation.accepted(t, before.values)
             self._note_changes(before)
-            self.h = min(cfg.max_step, max(cfg.min_step, h * self._grow(ratio)))
+            self.h = min(cfg.longest_step, max(cfg.min_step, h * self._grow(ratio)))
             self._remember_step(tuple(before.regimes), ratio, self.h)
             self.same_instant = 0
             # A regime that changed without a located switch changed at the step start.
@@ -409,7 +409,7 @@ class SinglePassMaster(RegimeAwareMaster):
         failure = self._chattering(h, end)
         if self.internal:
             # The rates go on: so does the step.
-            self.h = min(cfg.max_step, max(cfg.min_step, self.h_tried))
+            self.h = min(cfg.longest_step, max(cfg.min_step, self.h_tried))
         else:
             self.h = self._restart_step(tuple(system.regimes()))
         return MacroStep(
