@@ -56,6 +56,9 @@ class Variable:
     #: Of an output: the inputs it depends on directly within one instant (direct
     #: feedthrough, recomputed by ``update_outputs``).  Empty: it changes only by stepping.
     depends_on: tuple[str, ...] = ()
+    #: Of a Real: its typical magnitude (FMI 2.0 ``nominal``), where a relative measure of
+    #: it needs a floor: a speed starting from rest has no running scale yet.
+    nominal: float | None = None
 
 
 @dataclass(frozen=True)

@@ -94,8 +94,23 @@ class BrakeLoad(Component):
         Variable("angle0", "parameter", "rad", 0.0, "initial angle (forward positive)"),
         Variable("speed0", "parameter", "rad/s", 0.0, "initial speed"),
         Variable("torque", "input", "N.m", 0.0, "torque from the clutch (forward positive)"),
-        Variable("angle", "output", "rad", 0.0, "inner race / roller angle, forward positive"),
-        Variable("speed", "output", "rad/s", 0.0, "roller speed; zero while slipping = stop"),
+        # Nominals: a feed turns the roller about a radian at a few rad/s, from rest.
+        Variable(
+            "angle",
+            "output",
+            "rad",
+            0.0,
+            "inner race / roller angle, forward positive",
+            nominal=1.0,
+        ),
+        Variable(
+            "speed",
+            "output",
+            "rad/s",
+            0.0,
+            "roller speed; zero while slipping = stop",
+            nominal=1.0,
+        ),
         Variable("feed_length", "output", "m", 0.0, "strip advance since start"),
         Variable(
             "breakaway",

@@ -319,8 +319,18 @@ class CrankCouplerDrive(Component):
         *integration_variables(h_max=1.0e-3),
         Variable("torque", "input", "N.m", 0.0, "torque transmitted by the clutch (>= 0)"),
         Variable("phi1", "output", "rad", 0.0, "crank angle (absolute, unwrapped)"),
-        Variable("angle", "output", "rad", 0.0, "rocker / outer race angle, forward positive"),
-        Variable("speed", "output", "rad/s", 0.0, "rocker speed; zero = rocker reversal"),
+        # Nominals: the rocker swings about half a radian at a few rad/s; it starts at rest.
+        Variable(
+            "angle",
+            "output",
+            "rad",
+            0.0,
+            "rocker / outer race angle, forward positive",
+            nominal=1.0,
+        ),
+        Variable(
+            "speed", "output", "rad/s", 0.0, "rocker speed; zero = rocker reversal", nominal=1.0
+        ),
         Variable("q", "output", "m", 0.0, "coupler midpoint deflection (+ = tension)"),
         Variable("q_dot", "output", "m/s", 0.0, "coupler deflection rate"),
         Variable("strain", "output", "1", 0.0, "outer-fibre strain at the gauge (63)"),

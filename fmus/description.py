@@ -4,7 +4,7 @@ pythonfmu writes a model description without units, ranges or a ModelStructure w
 the name.  ``complete_description`` adds, from the component's VARIABLES table:
 
 * the unit definitions and the unit of every Real, and each parameter's valid range
-  (``min``/``max``);
+  (``min``/``max``); a Real's ``nominal`` where the component declares one;
 * the regime as an Enumeration type whose items name the regimes;
 * an honest ModelStructure: each output lists the inputs it depends on directly
   (``dependencies=""`` where it depends on none), so that other masters see no false
@@ -49,6 +49,8 @@ def complete_description(root: ET.Element, component_class: type[Component]) -> 
                 if var.unit not in units:
                     units.append(var.unit)
             _set_range(real, var)
+            if var.nominal is not None:
+                real.set("nominal", repr(float(var.nominal)))
         elif var.name == REGIME and regime_names:
             integer = sv.find("Integer")
             sv.remove(integer)

@@ -43,6 +43,8 @@ class VariableInfo:
     min: float | None
     max: float | None
     description: str
+    #: the declared ``nominal`` of a Real (None where the FMU declares none)
+    nominal: float | None = None
 
     @property
     def is_integer(self) -> bool:
@@ -193,6 +195,7 @@ def _variable(v: Any) -> VariableInfo:
         min=_bound(v.min if v.min is not None else getattr(declared, "min", None)),
         max=_bound(v.max if v.max is not None else getattr(declared, "max", None)),
         description=v.description or "",
+        nominal=_bound(getattr(v, "nominal", None)),
     )
 
 

@@ -146,6 +146,13 @@ class CoupledSystem:
             t_event=self._slot(i, model.event_time)[1] if model.event_time else None,
         )
 
+    def nominal(self, i: int, k: int) -> float:
+        """The declared nominal of instance i's Real read slot k (0 where none is declared):
+        the floor of a relative measure of that signal."""
+        var = self.models[i].variables.get(self.real_names[i][k])
+        nominal = var.nominal if var is not None else None
+        return abs(nominal) if nominal is not None else 0.0
+
     def real_output_slot(self, i: int, var: str) -> int:
         """Slot of instance i's Real output ``var`` in its read values, read from now on."""
         kind, slot = self._slot(i, var)

@@ -138,7 +138,9 @@ class RegimeAwareMaster:
             self.held_inputs[system.index[c.target[0]]].append((src, averaged))
         self.signals = sorted(held | unannotated)  # start hold: every held signal's change
         self.unannotated = sorted(unannotated)
-        self.scale = {s: 0.0 for s in self.signals}
+        # Running scales of the relative error measures, from each signal's declared nominal
+        # (FMI 2.0): a speed starting from rest is not held to its first millionths.
+        self.scale = {s: system.nominal(*s) for s in self.signals}
         black_boxes = sorted(
             {c.target[0] for c in system.connections}
             & {n for n, model in zip(self.names, system.models, strict=True) if not model.annotated}
@@ -152,7 +154,7 @@ class RegimeAwareMaster:
             )
         # Every Real connection source: its predictor-corrector difference is the error.
         self.outputs = sorted({s for s in system.connection_sources if s is not None})
-        self.out_scale = {s: 0.0 for s in self.outputs}
+        self.out_scale = {s: system.nominal(*s) for s in self.outputs}
         #: FMU states the predictors of this macro step kept, freed at its end
         self.kept_states: list[list[Any]] = []
         #: switches this close are one instant (chattering guard, landing on a located switch)

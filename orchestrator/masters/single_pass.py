@@ -342,7 +342,10 @@ class SinglePassMaster(RegimeAwareMaster):
             if i in returned:
                 continue
             a, b = start[i][k], end[i][k]
-            scale = self.scale[s] = max(self.scale.get(s, 0.0), abs(a), abs(b))
+            scale = self.scale.get(s)
+            if scale is None:
+                scale = self.system.nominal(i, k)
+            scale = self.scale[s] = max(scale, abs(a), abs(b))
             if scale > 0.0:
                 miss = abs(ex.mean(s, a, h) - 0.5 * (a + b))
                 worst = max(worst, miss / (tol * scale))
