@@ -266,6 +266,14 @@ def test_model_structure_lists_direct_dependencies() -> None:
     assert all(d == () for d in info.dependencies.values())
 
 
+def test_declared_nominals_reach_the_model_description_and_the_master() -> None:
+    load = model_info(build_fmu("BrakeLoad"))
+    assert load.variables["speed"].nominal == 1.0 and load.variables["angle"].nominal == 1.0
+    assert load.variables["torque"].nominal is None  # none declared: no floor
+    md = read_model_description(str(build_fmu("BrakeLoad")))
+    assert {v.name: v.nominal for v in md.modelVariables}["speed"] == "1.0"
+
+
 def test_vendor_annotation_declares_ports_sampled_inputs_regimes() -> None:
     verge = model_info(build_fmu("VergeEscapement"))
     assert verge.annotated and "escape_wheel" in verge.ports

@@ -161,3 +161,29 @@ def test_the_single_pass_takes_no_longest_step_of_its_own(overrides: dict, longe
         assert master.cfg.longest_step == pytest.approx(longest, rel=1e-12)
     finally:
         system.close()
+
+
+def test_error_scales_start_at_the_declared_nominals() -> None:
+    """The press feed's drive and load declare 1 rad and 1 rad/s: the midpoint hold's
+    relative error measures start there, not at zero (the load starts at rest)."""
+    from orchestrator.masters.regime_aware_choice import regime_aware
+    from orchestrator.recorder import StepStats
+    from orchestrator.system import CoupledSystem
+
+    scene = load_scene(SCENARIOS / "press_feed_run1.toml", {"master.algorithm": "regime-aware"})
+    system = CoupledSystem(scene)
+    try:
+        system.initialize()
+        master = regime_aware(system, scene, StepStats())
+        scales = {
+            (system.names[i], system.real_names[i][k]): v for (i, k), v in master.out_scale.items()
+        }
+        assert scales == {
+            ("drive", "angle"): 1.0,
+            ("drive", "speed"): 1.0,
+            ("load", "angle"): 1.0,
+            ("load", "speed"): 1.0,
+            ("clutch", "torque"): 0.0,  # declares none
+        }
+    finally:
+        system.close()
