@@ -55,7 +55,9 @@ def breakaway_margin(torque: float, brake_torque: float) -> float:
 
 
 class BrakeLoad(Component):
-    """Roller shaft + strip + constant dry friction; input: the clutch torque.
+    """Roller shaft + strip + constant dry friction; input: the clutch torque (held over a
+    step, or ramped about its held value by ``torque_rate`` where the shaft slips through
+    the whole step).
 
     Port ``shaft`` (angle, speed out; torque in) joins the clutch's inner race.
     ``ind_brake`` is the break-away margin while stuck and the speed while slipping: its
@@ -94,6 +96,13 @@ class BrakeLoad(Component):
         Variable("angle0", "parameter", "rad", 0.0, "initial angle (forward positive)"),
         Variable("speed0", "parameter", "rad/s", 0.0, "initial speed"),
         Variable("torque", "input", "N.m", 0.0, "torque from the clutch (forward positive)"),
+        Variable(
+            "torque_rate",
+            "input",
+            "N.m/s",
+            0.0,
+            "the torque's rate over a step: it ramps about its held value at mid-step",
+        ),
         # Nominals: a feed turns the roller about a radian at a few rad/s, from rest.
         Variable(
             "angle",
@@ -162,7 +171,41 @@ class BrakeLoad(Component):
         self.input_work += self.torque * d
         self.dissipated_work += self.brake_torque * abs(d)
 
+    def _slip_ramped(self, h: float) -> bool:
+        """Take the whole step slipping under the torque ramped about its held value,
+        T(s) = torque + torque_rate (s - h/2), if the shaft slips throughout; else False
+        (nothing done: a step with a stop or a break-away holds the torque, and its event
+        ends the master's step there)."""
+        direction = {REGIME_SLIP_FORWARD: 1.0, REGIME_SLIP_BACKWARD: -1.0}.get(self.regime)
+        if direction is None:
+            return False
+        r, j = self.torque_rate, self.j
+        a0 = (self.torque - 0.5 * r * h - direction * self.brake_torque) / j  # at s = 0
+        b = 0.5 * r / j  # v(s) = v0 + a0 s + b s^2
+
+        def v(s: float) -> float:
+            return self.speed + (a0 + b * s) * s
+
+        turn = -0.5 * a0 / b if b else -1.0  # where the speed turns, if inside the step
+        ends = (v(h), v(turn)) if 0.0 < turn < h else (v(h),)
+        if direction * self.speed < 0.0 or min(direction * x for x in ends) <= 0.0:
+            return False
+        d = (self.speed + (0.5 * a0 + b * h / 3.0) * h) * h
+        # Work of the ramped torque: T v is a cubic in s, exact by two-point Gauss.
+        work = 0.0
+        for x in (0.5 - 0.5 / math.sqrt(3.0), 0.5 + 0.5 / math.sqrt(3.0)):
+            s = x * h
+            work += 0.5 * h * (self.torque + r * (s - 0.5 * h)) * v(s)
+        self.speed = v(h)
+        self.angle += d
+        self.input_work += work
+        self.dissipated_work += self.brake_torque * abs(d)
+        return True
+
     def step(self, t: float, h: float) -> None:
+        if self.torque_rate and self._slip_ramped(h):
+            self.update_outputs()
+            return
         left = h
         for _ in range(3):  # at most: slip, stop, slip the other way
             if self.regime == REGIME_STICK:

@@ -191,18 +191,31 @@ def build_drive_model(
 
 
 class _CouplerMotion:
-    """The coupler equation over one step with the clutch torque held, for the shared
-    integrator: state [phi1, q, q', W_in, W_diss]; its one event is the rocker reversal
-    (``direction`` * rocker speed turns negative), which changes only the direction."""
+    """The coupler equation over one step with the clutch torque held (or ramped about its
+    step mean: ``torque + rate (t - t_mid)``, t_mid where the crank is at ``phi1_mid``), for
+    the shared integrator: state [phi1, q, q', W_in, W_diss]; its one event is the rocker
+    reversal (``direction`` * rocker speed turns negative), which changes only the
+    direction."""
 
-    __slots__ = ("m", "torque", "direction")
+    __slots__ = ("m", "torque", "direction", "rate", "phi1_mid")
 
-    def __init__(self, m: DriveModel, torque: float, direction: float) -> None:
+    def __init__(
+        self,
+        m: DriveModel,
+        torque: float,
+        direction: float,
+        rate: float = 0.0,
+        phi1_mid: float = 0.0,
+    ) -> None:
         self.m, self.torque, self.direction = m, torque, direction
+        self.rate, self.phi1_mid = rate, phi1_mid
 
     def deriv(self, y: list[float]) -> list[float]:
         m = self.m
-        qdd, _, _, p_in, p_diss = coupler_derivatives(m, y[0], y[1], y[2], self.torque)
+        torque = self.torque
+        if self.rate:  # the crank angle is the clock: t - t_mid = (phi1 - phi1_mid) / omega
+            torque += self.rate * (y[0] - self.phi1_mid) / m.omega
+        qdd, _, _, p_in, p_diss = coupler_derivatives(m, y[0], y[1], y[2], torque)
         return [m.omega, y[2], qdd, p_in, p_diss]
 
     def indicators(self, y: list[float]) -> tuple[float]:
@@ -222,8 +235,10 @@ class CrankCouplerDrive(Component):
     """Constant-speed crank, RSSR linkage with elastic bent coupler, rocker = outer race.
 
     Input ``torque``: the torque the clutch transmits (>= 0); it loads the rocker against
-    the feed stroke.  Internal event: rocker reversal (``speed`` = 0), located exactly;
-    it changes only the reported regime, not the equations.  The coupler equation is
+    the feed stroke.  Input ``torque_rate``: where a master knows how the torque moves over
+    a step, it ramps about ``torque`` at mid-step (a master's first-order hold; 0: held).
+    Internal event: rocker reversal (``speed`` = 0), located exactly; it changes only the
+    reported regime, not the equations.  The coupler equation is
     integrated by the shared Dormand-Prince pair (``components.event_integration``) with
     the torque held over the step; ``tolerance`` and ``h_max`` set its accuracy.
 
@@ -318,6 +333,13 @@ class CrankCouplerDrive(Component):
         # The rocker reverses twice a crank turn (0.3 s at 200 rpm): 1 ms steps see it.
         *integration_variables(h_max=1.0e-3),
         Variable("torque", "input", "N.m", 0.0, "torque transmitted by the clutch (>= 0)"),
+        Variable(
+            "torque_rate",
+            "input",
+            "N.m/s",
+            0.0,
+            "the torque's rate over a step: it ramps about its held value at mid-step",
+        ),
         Variable("phi1", "output", "rad", 0.0, "crank angle (absolute, unwrapped)"),
         # Nominals: the rocker swings about half a radian at a few rad/s; it starts at rest.
         Variable(
@@ -419,7 +441,9 @@ class CrankCouplerDrive(Component):
         speed = rocker_motion(m, phi1, self.q, self.q_dot)[1]
         # The side the rocker is on: from its speed, or at rest from the regime.
         forward = speed > 0.0 or (speed == 0.0 and self.regime == REGIME_FORWARD)
-        motion = _CouplerMotion(m, self.torque, 1.0 if forward else -1.0)
+        motion = _CouplerMotion(
+            m, self.torque, 1.0 if forward else -1.0, self.torque_rate, phi1 + 0.5 * m.omega * h
+        )
         y = [phi1, self.q, self.q_dot, self.input_work, self.dissipated_work]
         done = advance(motion, y, h, self._control, self._h_next)
         self._h_next = done.h_next

@@ -21,7 +21,13 @@ be rolled back.  A trial step is accepted when
   An FMU whose held inputs the correction leaves bit for bit as they were (the train while
   the verge flies free) is not stepped again: it is restored to its state just after the
   predictor's step.
-  Sampled inputs (a state taken at the step start) are never averaged.
+  Sampled inputs (a state taken at the step start) are never averaged.  Where an FMU
+  takes a held input's rate over the step (a Real input named after it with ``_rate``,
+  neither connected nor driven: the press feed's drive and brake take the clutch torque's),
+  the corrector also sets that rate, the slope from the start to the predicted end value,
+  so the input ramps through the step (first-order hold) rather than sitting at its mean:
+  the receiver then takes the first moment of its change too (press feed Run 1: trajectory
+  error 5.7e-4 against 7.5e-4 at 2e-4, 8.2e-4 against 1.1e-3 at 3e-4, in as many doSteps).
 
 After a switch the master iterates the exchange at that instant to a fixed point (so an
 impact's momentum exchange reaches the other FMU before anything moves), records the left
@@ -43,6 +49,9 @@ from orchestrator.masters.macro_step import MacroStep
 from orchestrator.observers import regime_changes
 from orchestrator.recorder import StepStats
 from orchestrator.system import CoupledSystem
+
+#: Suffix of the Real input by which an FMU takes a held input's rate over a step.
+RATE_SUFFIX = "_rate"
 
 
 @dataclass
@@ -136,6 +145,9 @@ class RegimeAwareMaster:
                 held.add(src)
             averaged = model.annotated and not sampled
             self.held_inputs[system.index[c.target[0]]].append((src, averaged))
+        #: (instance, index of the held input in its feed order, setter of its rate input)
+        self.ramps = self._ramped_inputs() if settings.midpoint else []
+        self._ramps_set: dict[tuple[int, int], tuple[int, float]] = {}
         self.signals = sorted(held | unannotated)  # start hold: every held signal's change
         self.unannotated = sorted(unannotated)
         # Running scales of the relative error measures, from each signal's declared nominal
@@ -164,6 +176,41 @@ class RegimeAwareMaster:
         self.zero_error_step: dict[tuple[int | None, ...], float] = {}
 
     # -- helpers ----------------------------------------------------------------------
+    def _ramped_inputs(self) -> list[tuple[int, int, Any]]:
+        """The averaged held inputs whose receiver takes their rate (``<input>_rate``)."""
+        system = self.system
+        taken = {tuple(c.target) for c in system.connections} | set(system.signals.driven)
+        ramps = []
+        for j, inputs in enumerate(self.held_inputs):
+            targets = [
+                c.target[1]
+                for c, src in zip(system.connections, system.connection_sources, strict=True)
+                if src is not None and system.index[c.target[0]] == j
+            ]
+            for k, ((_, averaged), name) in enumerate(zip(inputs, targets, strict=True)):
+                rate = system.models[j].variables.get(name + RATE_SUFFIX)
+                if (
+                    averaged
+                    and rate is not None
+                    and rate.causality == "input"
+                    and not rate.is_integer
+                    and (self.names[j], rate.name) not in taken
+                ):
+                    inst = system.instances[j]
+                    ramps.append((j, k, inst.setter(inst.refs([rate.name]))))
+        return ramps
+
+    def _set_ramps(self, rates: dict[tuple[int, int], float]) -> None:
+        """Set each ramped input's rate (0 where ``rates`` has none: held), unless the FMU
+        holds that value already (a restored state brings the rate it was saved with)."""
+        instances = self.system.instances
+        for j, k, setter in self.ramps:
+            value = rates.get((j, k), 0.0)
+            key = (instances[j].restores, value)
+            if self._ramps_set.get((j, k)) != key:
+                setter([value])
+                self._ramps_set[(j, k)] = key
+
     def readings(self) -> _Readings:
         s = self.system
         return _Readings(
@@ -179,6 +226,8 @@ class RegimeAwareMaster:
         system = self.system
         for i in range(len(system.instances)):
             system.feed(i)
+        if self.ramps:
+            self._set_ramps({})
         return _Predictor(t, h, self._step_all(t, h, keep=self.cfg.midpoint))
 
     def _step_all(
@@ -240,6 +289,12 @@ class RegimeAwareMaster:
         self.stats.rollbacks += 1
         for i in range(len(feeds)):
             system.feed(i, feeds[i], before.ints)
+        if self.ramps:
+            rates = {}
+            for j, k, _ in self.ramps:
+                s, n = self.held_inputs[j][k][0]
+                rates[(j, k)] = (predicted[s][n] - start[s][n]) / h
+            self._set_ramps(rates)
         self._step_all(t, h, retake)
         worst, tol = 0.0, self.cfg.tolerance
         values = system.values

@@ -507,3 +507,68 @@ def test_long_run_periodic_steady_state():
     f = [cyc["feed_angle"] for cyc in res.cycles[1:]]
     assert np.ptp(f) < 1e-6
     assert abs(res.energy["residual"]) < 1e-7 * res.energy["input_work"]
+
+
+def _ramp_by_substeps(make, h: float, torque: float, rate: float, n: int = 2000):
+    """The component after a step under T(s) = torque + rate (s - h/2), taken as n substeps
+    each holding the ramp's exact mean over it (converges to the ramp as 1/n^2)."""
+    c = make()
+    for i in range(n):
+        c.torque = torque + rate * ((i + 0.5) * h / n - 0.5 * h)
+        c.step(i * h / n, h / n)
+    return c
+
+
+def _slipping_load() -> BrakeLoad:
+    b = BrakeLoad()
+    b.brake_torque, b.speed0 = 10.0, 2.0
+    b.initialize(0.0)
+    return b
+
+
+def test_the_brake_load_takes_a_ramped_torque_exactly_while_it_slips():
+    h, torque, rate = 2e-3, 12.0, 4e3  # the torque crosses T_b within the step
+    b = _slipping_load()
+    b.torque, b.torque_rate = torque, rate
+    b.step(0.0, h)
+    ref = _ramp_by_substeps(_slipping_load, h, torque, rate)
+    assert b.regime == REGIME_SLIP_FORWARD
+    assert b.speed == pytest.approx(ref.speed, rel=1e-9)
+    assert b.angle == pytest.approx(ref.angle, rel=1e-6)
+    assert b.input_work == pytest.approx(ref.input_work, rel=1e-6)
+    held = _slipping_load()
+    held.torque = torque
+    held.step(0.0, h)
+    assert abs(held.angle - ref.angle) > 1e3 * abs(b.angle - ref.angle)  # the ramp's moment
+
+
+def test_the_brake_load_holds_the_torque_through_a_stop():
+    """A ramp that stops the shaft within the step is not taken: the held mean is (its
+    stop is exact for that torque, and the stop ends the master's step)."""
+    b = _slipping_load()
+    b.torque, b.torque_rate = 0.0, 1e3
+    b.step(0.0, 0.5)
+    held = _slipping_load()
+    held.torque = 0.0
+    held.step(0.0, 0.5)
+    assert (b.angle, b.speed, b.regime) == (held.angle, held.speed, held.regime)
+    assert b.regime == REGIME_STICK
+
+
+def test_the_crank_drive_takes_a_ramped_torque():
+    def drive() -> CrankCouplerDrive:
+        d = CrankCouplerDrive()
+        d.tolerance = 1e-12
+        d.initialize(0.0)
+        return d
+
+    h, torque, rate = 2e-3, 20.0, 1e4
+    d = drive()
+    d.torque, d.torque_rate = torque, rate
+    d.step(0.0, h)
+    ref = _ramp_by_substeps(drive, h, torque, rate, n=400)
+    held = drive()
+    held.torque = torque
+    held.step(0.0, h)
+    assert abs(d.q - ref.q) < 1e-3 * abs(held.q - ref.q)
+    assert d.q_dot == pytest.approx(ref.q_dot, rel=1e-6)

@@ -310,7 +310,7 @@ FEEDTHROUGH_CASES: dict[str, tuple[Callable[[], list[tuple[str, Component]]], di
             ("start", {}, {}, 0, 0.0),
             ("loaded", {}, {"torque": 10.0}, 5, 1e-3),
         ),
-        {"torque": 10.0},
+        {"torque": 10.0, "torque_rate": 1e5},  # the rate: a step's ramp, no output takes it
     ),
     "SpragClutch": (
         single(
@@ -322,7 +322,7 @@ FEEDTHROUGH_CASES: dict[str, tuple[Callable[[], list[tuple[str, Component]]], di
     ),
     "BrakeLoad": (
         single("BrakeLoad", ("stuck", {}, {}, 0, 0.0), ("slipping", {}, {"torque": 50.0}, 1, 1e-3)),
-        {"torque": 30.0},
+        {"torque": 30.0, "torque_rate": 1e5},
     ),
     "DetachedLever": (
         single(

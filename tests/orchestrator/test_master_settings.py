@@ -187,3 +187,27 @@ def test_error_scales_start_at_the_declared_nominals() -> None:
         }
     finally:
         system.close()
+
+
+@pytest.mark.parametrize(("hold", "ramped"), [("midpoint", {"drive", "load"}), ("start", set())])
+def test_the_midpoint_hold_ramps_the_inputs_whose_receivers_take_a_rate(
+    hold: str, ramped: set
+) -> None:
+    """The press feed's drive and load take ``torque_rate``: the midpoint corrector ramps
+    their clutch torque; the start hold (and every other master) leaves it held."""
+    from orchestrator.masters.regime_aware_choice import regime_aware
+    from orchestrator.recorder import StepStats
+    from orchestrator.system import CoupledSystem
+
+    overrides = {"master.algorithm": "regime-aware", "master.input_hold": hold}
+    scene = load_scene(SCENARIOS / "press_feed_run1.toml", overrides)
+    system = CoupledSystem(scene)
+    try:
+        system.initialize()
+        master = regime_aware(system, scene, StepStats())
+        assert {system.names[j] for j, _, _ in master.ramps} == ramped
+        for j, k, _ in master.ramps:
+            (source, slot), averaged = master.held_inputs[j][k]
+            assert averaged and system.real_names[source][slot] == "torque"
+    finally:
+        system.close()
