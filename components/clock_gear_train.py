@@ -174,6 +174,15 @@ class ClockTrainPhysics:
         self.set_mode(0.0, 1)
         self.theta1_0 = self.evaluate(0.0)[0]
 
+    # -- memos ------------------------------------------------------------------------------
+    def memos(self) -> tuple[Any, Any]:
+        """What it remembers of its last point (kinematics, response)."""
+        return self._memo, self._rmemo
+
+    def restore_memos(self, memos: tuple[Any, Any]) -> None:
+        """Remember that point again (after evaluations at a slope's neighbours)."""
+        self._memo, self._rmemo = memos
+
     # -- mode -------------------------------------------------------------------------------
     def mode_key(self) -> tuple[Any, ...]:
         """Everything discrete the response depends on (for memoisation by callers)."""

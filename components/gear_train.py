@@ -44,6 +44,7 @@ pitch-point crossings are located as events.
 from __future__ import annotations
 
 import math
+from typing import Any
 
 from .base import Variable, common_outputs
 from .escape_wheel import (
@@ -283,6 +284,14 @@ class TrainPhysics:
         """Rotor inertia with the acceleration-proportional pivot friction (clamped >= 0)."""
         v = self.d.i1 + self.i1r_sign * self.mu_abs * self.d.rho1 * (a26 + a30)
         return v if v > 0.0 else 0.0
+
+    def memos(self) -> Any:
+        """What it remembers of its last point (its response parts)."""
+        return self.__dict__.get("_memo")
+
+    def restore_memos(self, memos: Any) -> None:
+        """Remember that point again (after evaluations at a slope's neighbours)."""
+        self._memo = memos
 
     def parts(self, phi: float, phi_dot: float) -> tuple[float, ...]:
         """(J_ref, T_ref, F0, K, A42, A43, A44): the response (*), F23 = F0 + K phi_dd

@@ -154,10 +154,15 @@ class TrainComponent(Component):
         dp = SLOPE_STEP_ANGLE
         dw = SLOPE_STEP_SPEED * max(1.0, abs(phi_dot))
         # Each angle's two quantities together: the physics keeps its kinematics at one angle.
+        # It remembers the state's point again after each pair of neighbours: the speed
+        # neighbours share its kinematics, and the outputs ask for its response next.
+        at_state = p.memos()
         (j_hi, t_hi, _), i_hi = p.response(phi + dp, phi_dot), p.impact_inertia(phi + dp)
         (j_lo, t_lo, _), i_lo = p.response(phi - dp, phi_dot), p.impact_inertia(phi - dp)
+        p.restore_memos(at_state)
         t_fast = p.response(phi, phi_dot + dw)[1]
         t_slow = p.response(phi, phi_dot - dw)[1]
+        p.restore_memos(at_state)
         return (
             (j_hi - j_lo) / (2.0 * dp),
             (t_hi - t_lo) / (2.0 * dp),

@@ -59,7 +59,7 @@ class Recorder:
     def row(self, values: list[float]) -> None:
         """Record one row; a value that is not finite is recorded, then ends the run."""
         self.rows.append(values)
-        self._writer.writerow([repr(v) for v in values])
+        self._writer.writerow(values)  # a float's str is its repr: every digit
         try:
             finite = math.isfinite(math.fsum(values))
         except (OverflowError, ValueError):  # an overflowing sum, or inf - inf: look closer
