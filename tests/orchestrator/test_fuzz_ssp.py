@@ -8,6 +8,7 @@ The default suite runs a few examples; ``-m slow`` many more.
 
 from __future__ import annotations
 
+import copy
 import tempfile
 import xml.etree.ElementTree as ET
 import zipfile
@@ -101,7 +102,9 @@ def mutated_ssd(draw) -> bytes:
                 f"{{{SSD}}}System/{{{SSD}}}{'Elements' if tag == 'Component' else 'Connections'}"
             )
             if elements and parent is not None:
-                parent.append(ET.fromstring(ET.tostring(draw(st.sampled_from(elements)))))
+                # A copy, not a serialized round trip: a renamed attribute may hold
+                # characters XML cannot carry, which the archive's reader must refuse.
+                parent.append(copy.deepcopy(draw(st.sampled_from(elements))))
         else:  # the stop time
             experiment = root.find(f"{{{SSD}}}DefaultExperiment")
             if experiment is not None:
