@@ -240,7 +240,7 @@ class CrankCouplerDrive(Component):
     Internal event: rocker reversal (``speed`` = 0), located exactly; it changes only the
     reported regime, not the equations.  The coupler equation is
     integrated by the shared Dormand-Prince pair (``components.event_integration``) with
-    the torque held over the step; ``tolerance`` and ``h_max`` set its accuracy.
+    the torque held (or ramped) over the step; ``tolerance`` and ``h_max`` set its accuracy.
 
     Port ``rocker`` (angle, speed out; torque in) joins the clutch's outer race.  The crank
     work is ``external_work`` (brought in from outside the scene, see components.base);
