@@ -237,3 +237,16 @@ def common_outputs(**depends_on: tuple[str, ...]) -> tuple[Variable, ...]:
     if unknown:
         raise KeyError(f"not common outputs: {unknown}")
     return tuple(replace(v, depends_on=depends_on.get(v.name, ())) for v in COMMON_OUTPUTS)
+
+
+def rate_input(name: str, unit: str) -> Variable:
+    """The Real input ``<name>_rate`` by which a component takes how its input ``name``
+    moves over a step: the input then ramps through the step about its held value at
+    mid-step (a master's first-order hold; 0, the start value: held)."""
+    return Variable(
+        f"{name}_rate",
+        "input",
+        f"{unit}/s",
+        0.0,
+        f"rate of {name} over a step: it ramps about its held value at mid-step",
+    )

@@ -18,7 +18,14 @@ from __future__ import annotations
 
 import math
 
-from .base import COMMON_OUTPUTS, Component, ComponentError, SnapshotPlan, Variable
+from .base import (
+    COMMON_OUTPUTS,
+    Component,
+    ComponentError,
+    SnapshotPlan,
+    Variable,
+    rate_input,
+)
 from .press_feed_data import APP_H_J_O5, LBF_IN, ROLLER_RADIUS
 
 REGIME_STICK = 0
@@ -96,13 +103,7 @@ class BrakeLoad(Component):
         Variable("angle0", "parameter", "rad", 0.0, "initial angle (forward positive)"),
         Variable("speed0", "parameter", "rad/s", 0.0, "initial speed"),
         Variable("torque", "input", "N.m", 0.0, "torque from the clutch (forward positive)"),
-        Variable(
-            "torque_rate",
-            "input",
-            "N.m/s",
-            0.0,
-            "the torque's rate over a step: it ramps about its held value at mid-step",
-        ),
+        rate_input("torque", "N.m"),
         # Nominals: a feed turns the roller about a radian at a few rad/s, from rest.
         Variable(
             "angle",
@@ -176,12 +177,12 @@ class BrakeLoad(Component):
         T(s) = torque + torque_rate (s - h/2), if the shaft slips throughout; else False
         (nothing done: a step with a stop or a break-away holds the torque, and its event
         ends the master's step there)."""
-        direction = {REGIME_SLIP_FORWARD: 1.0, REGIME_SLIP_BACKWARD: -1.0}.get(self.regime)
-        if direction is None:
+        if self.regime == REGIME_STICK:
             return False
+        direction = 1.0 if self.regime == REGIME_SLIP_FORWARD else -1.0
         r, j = self.torque_rate, self.j
-        a0 = (self.torque - 0.5 * r * h - direction * self.brake_torque) / j  # at s = 0
-        b = 0.5 * r / j  # v(s) = v0 + a0 s + b s^2
+        a0 = shaft_acceleration(self.regime, self.torque - 0.5 * r * h, self.brake_torque, j)
+        b = 0.5 * r / j  # v(s) = v0 + a0 s + b s^2, a0 at s = 0
 
         def v(s: float) -> float:
             return self.speed + (a0 + b * s) * s

@@ -22,7 +22,14 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from .base import COMMON_OUTPUTS, Component, ComponentError, SnapshotPlan, Variable
+from .base import (
+    COMMON_OUTPUTS,
+    Component,
+    ComponentError,
+    SnapshotPlan,
+    Variable,
+    rate_input,
+)
 from .event_integration import advance, integration_step_control, integration_variables
 from .press_feed_data import (
     APP_H_FOURIER,
@@ -333,13 +340,7 @@ class CrankCouplerDrive(Component):
         # The rocker reverses twice a crank turn (0.3 s at 200 rpm): 1 ms steps see it.
         *integration_variables(h_max=1.0e-3),
         Variable("torque", "input", "N.m", 0.0, "torque transmitted by the clutch (>= 0)"),
-        Variable(
-            "torque_rate",
-            "input",
-            "N.m/s",
-            0.0,
-            "the torque's rate over a step: it ramps about its held value at mid-step",
-        ),
+        rate_input("torque", "N.m"),
         Variable("phi1", "output", "rad", 0.0, "crank angle (absolute, unwrapped)"),
         # Nominals: the rocker swings about half a radian at a few rad/s; it starts at rest.
         Variable(

@@ -134,20 +134,26 @@ class RegimeAwareMaster:
         # order, as with input_hold = "start").
         held, unannotated = set(), set()
         self.held_inputs: list[list[tuple[tuple[int, int], bool]]] = [[] for _ in self.names]
+        #: (instance, index of the held input in its feed order, setter of its rate input):
+        #: the midpoint corrector's ramped inputs
+        self.ramps: list[tuple[int, int, Any]] = []
+        self._ramps_set: dict[tuple[int, int], tuple[int, float]] = {}
         for c, src in zip(system.connections, system.connection_sources, strict=True):
             if src is None:
                 continue
-            model = system.models[system.index[c.target[0]]]
+            j = system.index[c.target[0]]
+            model = system.models[j]
             sampled = c.target[1] in model.sampled
             if not model.annotated:
                 unannotated.add(src)
             elif not sampled:
                 held.add(src)
             averaged = model.annotated and not sampled
-            self.held_inputs[system.index[c.target[0]]].append((src, averaged))
-        #: (instance, index of the held input in its feed order, setter of its rate input)
-        self.ramps = self._ramped_inputs() if settings.midpoint else []
-        self._ramps_set: dict[tuple[int, int], tuple[int, float]] = {}
+            if averaged and settings.midpoint:
+                rate = self._rate_input(j, c.target[1])
+                if rate is not None:
+                    self.ramps.append((j, len(self.held_inputs[j]), rate))
+            self.held_inputs[j].append((src, averaged))
         self.signals = sorted(held | unannotated)  # start hold: every held signal's change
         self.unannotated = sorted(unannotated)
         # Running scales of the relative error measures, from each signal's declared nominal
@@ -176,29 +182,20 @@ class RegimeAwareMaster:
         self.zero_error_step: dict[tuple[int | None, ...], float] = {}
 
     # -- helpers ----------------------------------------------------------------------
-    def _ramped_inputs(self) -> list[tuple[int, int, Any]]:
-        """The averaged held inputs whose receiver takes their rate (``<input>_rate``)."""
+    def _rate_input(self, j: int, name: str) -> Any:
+        """A setter of instance j's ``<name>_rate`` input, None where it takes no rate (no
+        such Real input, or one a connection or a scene signal drives)."""
         system = self.system
-        taken = {tuple(c.target) for c in system.connections} | set(system.signals.driven)
-        ramps = []
-        for j, inputs in enumerate(self.held_inputs):
-            targets = [
-                c.target[1]
-                for c, src in zip(system.connections, system.connection_sources, strict=True)
-                if src is not None and system.index[c.target[0]] == j
-            ]
-            for k, ((_, averaged), name) in enumerate(zip(inputs, targets, strict=True)):
-                rate = system.models[j].variables.get(name + RATE_SUFFIX)
-                if (
-                    averaged
-                    and rate is not None
-                    and rate.causality == "input"
-                    and not rate.is_integer
-                    and (self.names[j], rate.name) not in taken
-                ):
-                    inst = system.instances[j]
-                    ramps.append((j, k, inst.setter(inst.refs([rate.name]))))
-        return ramps
+        rate = system.models[j].variables.get(name + RATE_SUFFIX)
+        if rate is None or rate.causality != "input" or rate.is_integer:
+            return None
+        target = (self.names[j], rate.name)
+        if target in system.signals.driven or any(
+            tuple(c.target) == target for c in system.connections
+        ):
+            return None
+        inst = system.instances[j]
+        return inst.setter(inst.refs([rate.name]))
 
     def _set_ramps(self, rates: dict[tuple[int, int], float]) -> None:
         """Set each ramped input's rate (0 where ``rates`` has none: held), unless the FMU

@@ -342,10 +342,7 @@ class SinglePassMaster(RegimeAwareMaster):
             if i in returned:
                 continue
             a, b = start[i][k], end[i][k]
-            scale = self.scale.get(s)
-            if scale is None:
-                scale = self.system.nominal(i, k)
-            scale = self.scale[s] = max(scale, abs(a), abs(b))
+            scale = self.scale[s] = max(self.scale[s], abs(a), abs(b))  # from its nominal
             if scale > 0.0:
                 miss = abs(ex.mean(s, a, h) - 0.5 * (a + b))
                 worst = max(worst, miss / (tol * scale))
