@@ -9,7 +9,9 @@ that master runs and monolithic runs are measured against the same value.
 
 The time the monolithic model needs for an accuracy ``e`` is read off the curve's lower
 envelope as measured: the least wall time among the monolithic runs whose error is <= e
-(a step function; no interpolation, so every time it returns is a run's own).
+(a step function; no interpolation, so every time it returns is a run's own).  A report
+that also times co-simulation runs times the curve again between their rounds
+(``retime``), so that both see the same slow and fast spells of a shared machine.
 """
 
 from __future__ import annotations
@@ -107,6 +109,16 @@ def monolithic_curve(
         err = curve.relative_error(result.turns) if result.armed else math.nan
         curve.points.append(MonolithicPoint(tol, wall, err))
     return curve
+
+
+def retime(curve: MonolithicCurve, model: Callable[[float], Any]) -> MonolithicCurve:
+    """The curve with each tolerance run once more, its least time kept (the model is
+    deterministic: its errors stay)."""
+    points = []
+    for p in curve.points:
+        wall, _ = _best_time(lambda tol=p.tolerance: model(tol), 1)
+        points.append(MonolithicPoint(p.tolerance, min(p.wall_time, wall), p.error))
+    return MonolithicCurve(curve.truth, curve.truth_wall_time, points)
 
 
 def _parameter(scene: Scene, instance: str, name: str) -> float:

@@ -21,6 +21,7 @@ from orchestrator.studies.monolithic_curve import (
     envelope_time,
     monolithic_curve,
     monolithic_model,
+    retime,
     time_in_window,
 )
 from orchestrator.studies.work_precision import MONOLITHIC, ONE_PASS, Row, summary, work_precision
@@ -79,6 +80,52 @@ def test_monolithic_curve_times_each_tolerance_against_the_truth() -> None:
     # A truth that does not arm (a stop before arming) gives the reason, not a curve.
     never = monolithic_curve(lambda tolerance: SimpleNamespace(armed=False, reason="stop"), (1e-3,))
     assert never == "did not arm at tolerance 1e-12 (stop): no turns error"
+
+
+def test_retime_runs_each_tolerance_again_and_keeps_the_least_time() -> None:
+    calls = []
+
+    def model(tolerance: float):
+        calls.append(tolerance)
+        return SimpleNamespace(armed=True, turns=1.0, reason="")
+
+    slow = MonolithicCurve(
+        1.0, 5.0, [MonolithicPoint(1e-3, 1e9, 2e-4), MonolithicPoint(1e-5, 1e9, 3e-6)]
+    )
+    again = retime(slow, model)
+    assert calls == [1e-3, 1e-5]
+    assert [(p.tolerance, p.error) for p in again.points] == [(1e-3, 2e-4), (1e-5, 3e-6)]
+    assert all(0 < p.wall_time < 1e9 for p in again.points)  # the new, shorter time
+    assert (again.truth, again.truth_wall_time) == (1.0, 5.0)
+    fast = MonolithicCurve(1.0, 5.0, [MonolithicPoint(1e-3, 0.0, 2e-4)])
+    assert retime(fast, model).points[0].wall_time == 0.0  # the earlier, shorter time
+
+
+def test_the_report_times_the_curve_and_the_masters_in_alternate_rounds(
+    tmp_path: Path, monkeypatch
+) -> None:
+    """Each round times the monolithic curve once and then runs every master setting once:
+    a slow spell of a shared machine falls on both sides of the ratios."""
+    import orchestrator.studies.work_precision as wp
+
+    order = []
+    curve = MonolithicCurve(1.0, 1.0, [MonolithicPoint(1e-3, 1.0, 1e-4)])
+    monkeypatch.setattr(wp, "reference_of", lambda scene: SimpleNamespace(wall_time=1.0))
+    monkeypatch.setattr(wp, "monolithic_model", lambda scene: lambda tol: None)
+    monkeypatch.setattr(wp, "monolithic_curve", lambda *a: order.append("curve") or curve)
+    monkeypatch.setattr(wp, "retime", lambda c, m: order.append("retime") or c)
+    monkeypatch.setattr(wp, "run_jobs", lambda jobs, **k: order.append("masters") or [])
+    monkeypatch.setattr(wp, "sweep_jobs", lambda *a: [])
+    monkeypatch.setattr(wp, "plot_records", lambda *a: None)
+    scene = SCENARIOS / "clock_train_sa.toml"
+    wp.work_precision(scene, tmp_path / "a", repeats=3, monolithic_repeats=3)
+    assert order == ["curve", "masters", "retime", "masters", "retime", "masters"]
+    order.clear()
+    wp.work_precision(scene, tmp_path / "b", repeats=1, monolithic_repeats=3)
+    assert order == ["curve", "masters", "retime", "retime"]
+    order.clear()
+    wp.work_precision(scene, tmp_path / "c", repeats=2, monolithic_repeats=1)
+    assert order == ["curve", "masters", "masters"]
 
 
 def _row(master, tol, wall, turns_error, mono=math.nan, setting="tolerance") -> Row:
