@@ -139,27 +139,25 @@ class TrainComponent(Component):
         The slopes of the last state and mode are kept: the outputs after a step and
         those after the exchange that follows ask at the same point."""
         p = self._phys
+        self.J_ref, self.T_ref, self.c_load = p.response(phi, phi_dot)
+        self.J_stot = p.impact_inertia(phi)
         key = (phi, phi_dot, p.mode_key())
         if key != self._slopes_at:
             self._slopes, self._slopes_at = self._slopes_of(phi, phi_dot), key
         self.J_ref_phi, self.T_ref_phi, self.T_ref_phi_dot, self.J_stot_phi = self._slopes
-        self.J_ref, self.T_ref, self.c_load = p.response(phi, phi_dot)
-        self.J_stot = p.impact_inertia(phi)
 
     def _slopes_of(self, phi: float, phi_dot: float) -> tuple[float, float, float, float]:
         """(J_ref, T_ref in phi; T_ref in phi_dot; J_stot in phi): forward differences from
-        the state, whose response and impact inertia the outputs take anyway (a central
-        difference costs two evaluations more per output; the one-sided truncation, dp/2
-        times the second derivative, is about 1e-5 of the slope on the clock train).  The
-        evaluation in the speed comes last: the physics remembers its last point (the
-        friction branches read it), which so ends at the state."""
+        the state's response and impact inertia, just sent (a central difference costs two
+        evaluations more per output; the one-sided truncation, dp/2 times the second
+        derivative, is about 1e-5 of the slope on the clock train).  The physics remembers
+        its last point (the friction branches read it): after each neighbour it remembers
+        the state's again, so the neighbour in the speed shares the state's kinematics and
+        the step ends at the state."""
         p = self._phys
         dp = SLOPE_STEP_ANGLE
         dw = SLOPE_STEP_SPEED * max(1.0, abs(phi_dot))
-        (j_0, t_0, _), i_0 = p.response(phi, phi_dot), p.impact_inertia(phi)
-        # The physics keeps its kinematics at one angle: it remembers the state's point
-        # again after the neighbour in the angle, so the one in the speed shares the
-        # state's kinematics, and after that, when the outputs ask for its response.
+        j_0, t_0, i_0 = self.J_ref, self.T_ref, self.J_stot
         at_state = p.memos()
         (j_hi, t_hi, _), i_hi = p.response(phi + dp, phi_dot), p.impact_inertia(phi + dp)
         p.restore_memos(at_state)

@@ -29,7 +29,7 @@ TRUTH_TOLERANCE = 1e-12
 #: The monolithic model's tolerances: M739's turns error falls from 0.1 (at 1e-4 the model
 #: takes another path through the escapement) through 1e-3 .. 1e-6 to about 1e-9.
 CURVE_TOLERANCES = (1e-3, 3e-4, 1e-4, 3e-5, 1e-5, 3e-6, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10)
-#: Timed repeats of each monolithic run (the least is kept).
+#: Timed runs of each monolithic tolerance (the least is kept).
 REPEATS = 3
 #: The accuracy window of the comparison (issue target: turns error 1e-6 .. 1e-3) and the
 #: largest ratio master time / monolithic time at the same accuracy it asks for.
@@ -83,29 +83,25 @@ def time_in_window(
     return curve.time_for(error)
 
 
-def _best_time(fn: Callable[[], Any], repeats: int) -> tuple[float, Any]:
-    best, result = math.inf, None
-    for _ in range(max(1, repeats)):
-        t0 = time.perf_counter()
-        result = fn()
-        best = min(best, time.perf_counter() - t0)
-    return best, result
+def _timed(fn: Callable[[], Any]) -> tuple[float, Any]:
+    t0 = time.perf_counter()
+    result = fn()
+    return time.perf_counter() - t0, result
 
 
 def monolithic_curve(
-    model: Callable[[float], Any],
-    tolerances: Sequence[float] = CURVE_TOLERANCES,
-    repeats: int = REPEATS,
+    model: Callable[[float], Any], tolerances: Sequence[float] = CURVE_TOLERANCES
 ) -> MonolithicCurve | str:
     """Run ``model(tolerance)`` (a result with ``armed``, ``turns`` and ``reason``) at the
-    truth's tolerance and at each of ``tolerances``, timed, errors against the truth.
-    When the truth does not arm (e.g. a stop before arming), why, instead of a curve."""
-    truth_time, truth = _best_time(lambda: model(TRUTH_TOLERANCE), 1)
+    truth's tolerance and at each of ``tolerances``, each timed once (``retime`` times them
+    again), errors against the truth.  When the truth does not arm (e.g. a stop before
+    arming), why, instead of a curve."""
+    truth_time, truth = _timed(lambda: model(TRUTH_TOLERANCE))
     if not truth.armed:
         return f"did not arm at tolerance {TRUTH_TOLERANCE:g} ({truth.reason}): no turns error"
     curve = MonolithicCurve(truth.turns, truth_time, [])
     for tol in tolerances:
-        wall, result = _best_time(lambda tol=tol: model(tol), repeats)
+        wall, result = _timed(lambda tol=tol: model(tol))
         err = curve.relative_error(result.turns) if result.armed else math.nan
         curve.points.append(MonolithicPoint(tol, wall, err))
     return curve
@@ -114,10 +110,12 @@ def monolithic_curve(
 def retime(curve: MonolithicCurve, model: Callable[[float], Any]) -> MonolithicCurve:
     """The curve with each tolerance run once more, its least time kept (the model is
     deterministic: its errors stay)."""
-    points = []
-    for p in curve.points:
-        wall, _ = _best_time(lambda tol=p.tolerance: model(tol), 1)
-        points.append(MonolithicPoint(p.tolerance, min(p.wall_time, wall), p.error))
+    points = [
+        MonolithicPoint(
+            p.tolerance, min(p.wall_time, _timed(lambda p=p: model(p.tolerance))[0]), p.error
+        )
+        for p in curve.points
+    ]
     return MonolithicCurve(curve.truth, curve.truth_wall_time, points)
 
 

@@ -208,7 +208,7 @@ def work_precision(
     model = monolithic_model(scene)
     curve, notes = None, []
     if model is not None:
-        curve = monolithic_curve(model, monolithic_tolerances, 1)
+        curve = monolithic_curve(model, monolithic_tolerances)
         if isinstance(curve, str):
             curve, notes = None, [f"The monolithic model {curve}."]
     jobs = sweep_jobs(

@@ -71,8 +71,8 @@ def test_monolithic_curve_times_each_tolerance_against_the_truth() -> None:
             return SimpleNamespace(armed=False, turns=None, reason="stalled")
         return SimpleNamespace(armed=True, turns=truth * (1 + 10 * tolerance), reason="")
 
-    curve = monolithic_curve(model, (1e-2, 1e-4, 1e-6), repeats=2)
-    assert calls == [1e-12, 1e-2, 1e-2, 1e-4, 1e-4, 1e-6, 1e-6]  # truth once, each twice
+    curve = monolithic_curve(model, (1e-2, 1e-4, 1e-6))
+    assert calls == [1e-12, 1e-2, 1e-4, 1e-6]  # each once: retime times them again
     assert curve.truth == pytest.approx(truth * (1 + 1e-11))
     assert math.isnan(curve.points[0].error)
     assert [p.error for p in curve.points[1:]] == pytest.approx([1e-3, 1e-5], rel=1e-6)
