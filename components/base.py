@@ -59,6 +59,26 @@ class Variable:
     #: Of a Real: its typical magnitude (FMI 2.0 ``nominal``), where a relative measure of
     #: it needs a floor: a speed starting from rest has no running scale yet.
     nominal: float | None = None
+    #: Of a parameter: a quantity of the mechanism's design, as its source program read it
+    #: (its description ends with the source symbol, "[SANDA2V: CAPRB1]").  A scene states
+    #: it once, in its design, and every FMU of the scene that declares it takes that value.
+    design: bool = False
+
+
+def design_parameter(
+    name: str,
+    unit: str,
+    start: float,
+    meaning: str,
+    source: str,
+    type: Literal["Real", "Integer"] = "Real",
+    **bounds: Any,
+) -> Variable:
+    """A design quantity: a parameter whose description names its source symbol,
+    ``meaning [source]`` (e.g. source "SANDA2V: CAPRB1")."""
+    return Variable(
+        name, "parameter", unit, start, f"{meaning} [{source}]", type, design=True, **bounds
+    )
 
 
 @dataclass(frozen=True)

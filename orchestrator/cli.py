@@ -56,6 +56,14 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--force", action="store_true", help="accept more than 1e8 macro steps")
     p.set_defaults(handler=_check)
 
+    p = sub.add_parser(
+        "draw", help="draw a scene's mechanism to scale as entered (its design), before a run"
+    )
+    p.add_argument("scene", type=Path, help="scenario file (TOML)")
+    p.add_argument("--output", type=Path, help="the PNG to write (default: <scene name>.png here)")
+    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
+    p.set_defaults(handler=_draw)
+
     p = sub.add_parser("build", help="build FMUs (all if none named) into the cache")
     p.add_argument("names", nargs="*")
     p.add_argument("--force", action="store_true", help="rebuild even if cached")
@@ -328,6 +336,23 @@ def _check(args: argparse.Namespace) -> int:
         scene = _load(path, _overrides(args.set), args.force)
         counts = f"{len(scene.fmus)} FMUs, {len(scene.connections)} connections"
         print(f"{path}: ok ({scene.name}, {counts})")
+    return 0
+
+
+def _draw(args: argparse.Namespace) -> int:
+    from orchestrator.scenes import DRAWINGS
+
+    scene = _load(args.scene, _overrides(args.set), False)
+    name = getattr(scene, "family", None)
+    if name is None or name not in DRAWINGS:
+        raise ScenarioError(
+            args.scene,
+            "report.family",
+            f"{name!r} has no drawing; drawn are the families {sorted(DRAWINGS)}",
+        )
+    out = args.output or Path(f"{scene.name}.png")
+    DRAWINGS[name](scene, out)
+    print(f"{args.scene}: drawn to {out}")
     return 0
 
 

@@ -56,3 +56,5 @@ ANALYSES = _registry("analysis")
 PLOTS = _registry("plot")
 #: (scene) -> Reference
 REFERENCES = _registry("reference")
+#: (scene, path) -> None, a PNG of the design to scale
+DRAWINGS = _registry("drawing")

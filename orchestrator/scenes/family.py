@@ -111,6 +111,7 @@ class SceneFamily:
     plot: (scene, header, data, path) -> None, writing a PNG at path
     reference: (scene) -> Reference, the monolithic yardstick of the coupling error
     shared: the parameters its FMUs share (they hold in every scene with those FMUs)
+    drawing: (scene, path) -> None, writing a PNG of the scene's design to scale
     """
 
     needs: Needs = field(default_factory=Needs)
@@ -118,3 +119,4 @@ class SceneFamily:
     plot: str | None = None
     reference: str | None = None
     shared: tuple[SharedParameter, ...] = ()
+    drawing: str | None = None
