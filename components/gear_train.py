@@ -47,6 +47,7 @@ import math
 from typing import Any
 
 from .base import Variable, common_outputs
+from .design_rules import raise_first
 from .escape_wheel import (
     ESCAPE_WHEEL_PORT,
     ESCAPE_WHEEL_VARIABLES,
@@ -57,8 +58,9 @@ from .escape_wheel import (
 )
 from .event_integration import INTEGRATION_VARIABLES
 from .m739_data import M739, M739Data
+from .sanda2v_deck import TRAIN, deck_variables, design_of, train_violations
 from .train_component import TrainComponent, TrainLoadModel
-from .verge_geometry import fuze_angles
+from .verge_geometry import train_angles
 
 INDEXING_PHYSICAL = 0
 INDEXING_AS_RUN = 1
@@ -100,7 +102,7 @@ class TrainPhysics:
         self.d = d
         self.mu_abs = abs(d.mu if mu is None else mu)
         self.omega = d.omega if omega is None else omega
-        ang = fuze_angles(d)
+        ang = train_angles(d)
         self.angles = ang
         om2 = self.omega**2
         self.om2 = om2
@@ -454,11 +456,8 @@ class GearTrain(TrainComponent):
     PORTS = {"escape_wheel": ESCAPE_WHEEL_PORT}
 
     VARIABLES = (
-        Variable(
-            "mu", "parameter", "1", M739.mu, "Coulomb friction, teeth and train pivots", min=0.0
-        ),
-        # The model takes |omega| (spin in either sense gives the same motion): spin >= 0.
-        Variable("spin", "parameter", "rad/s", M739.omega, "fuze spin rate omega", min=0.0),
+        # The SANDA2V deck's train quantities (cards 3-15): the bodies, pivots and meshes.
+        *deck_variables(TRAIN),
         Variable(
             "indexing",
             "parameter",
@@ -510,14 +509,19 @@ class GearTrain(TrainComponent):
 
     def initialize(self, t0: float) -> None:
         self._start_integration()
-        self._phys = TrainPhysics(M739, mu=self.mu, omega=self.spin, indexing=int(self.indexing))
+        self.check_parameters()
+        data = design_of(self, TRAIN)
+        if self.check_design:
+            raise_first(train_violations(data))  # a broken design is refused, not run
+        self._data = data
+        self._phys = TrainPhysics(data, mu=self.mu, omega=self.spin, indexing=int(self.indexing))
         self._y = [self.phi_start, self.phi_dot_start, 0.0]
         direction = -1 if self.phi_dot_start < 0.0 else 1
         self._phys.set_mode(self.phi_start, direction)
         self._model = _TrainModel(self._phys)
         self._take_loads()
         self._seen_impacts = int(self.impact_count)
-        self._cos0 = math.cos(M739.phi1c + self._phys.n31 * self.phi_start)
+        self._cos0 = math.cos(data.phi1c + self._phys.n31 * self.phi_start)
         self.t_event = -1.0
         if self.phi_dot_start == 0.0:
             self._model.try_unstick(self.phi_start)
@@ -534,7 +538,7 @@ class GearTrain(TrainComponent):
         unloaded = self.T_esc == 0.0
         self.FF12 = f12 if unloaded else 0.0
         self.FF23 = f23 if unloaded else 0.0
-        self.rotor_angle = M739.phi1c + p.n31 * phi
+        self.rotor_angle = self._data.phi1c + p.n31 * phi
         self.s1, self.s2 = p.s1, p.s2
         hi, lo = p.mesh_indicators(phi)
         self.indicator_mesh = hi if p.direction > 0 else lo
@@ -544,5 +548,5 @@ class GearTrain(TrainComponent):
             self.regime = TRAIN_FORWARD if p.direction > 0 else TRAIN_BACKWARD
         self.stored_energy = 0.5 * p.i_stot * w * w
         # Work of the spin (centrifugal moment on the eccentric rotor) since the start.
-        self.external_work = p.a35 * (math.cos(M739.phi1c + p.n31 * phi) - self._cos0)
+        self.external_work = p.a35 * (math.cos(self._data.phi1c + p.n31 * phi) - self._cos0)
         self.dissipated_work = wd

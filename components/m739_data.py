@@ -61,7 +61,10 @@ class M739Data:
     mu1: float = 0.10
     # Spin; source rev/min.
     rpm: float = 30000.0
-    # Gear train (teeth, pitch radii, pressure angles); source inch and degrees.
+    # Gear train (diametral pitch, teeth, pitch radii, pressure angles); source 1/in, inch
+    # and degrees.  The diametral pitches are read but enter no equation.
+    psubd1: float = 80.0 / INCH
+    psubd2: float = 100.0 / INCH
     ng1: int = 64
     ng2: int = 36
     np2: int = 9

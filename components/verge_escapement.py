@@ -55,10 +55,12 @@ from collections.abc import Callable
 from typing import Any
 
 from .base import Component, ComponentError, SnapshotPlan, Variable, common_outputs
+from .design_rules import raise_first
 from .early_return import EARLY_RETURN_VARIABLES, UntilFirstEvent, reached
 from .escape_wheel import ESCAPE_WHEEL_PORT
 from .event_integration import INTEGRATION_VARIABLES, advance, integration_step_control
 from .m739_data import M739, M739Data
+from .sanda2v_deck import VERGE, deck_variables, design_of, verge_violations
 from .step_moments import WithMoments
 from .verge_geometry import (
     TWO_PI,
@@ -410,6 +412,9 @@ class VergeCore:
         self.last_impact: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 0.0)
         self.stall_reason = ""
         self.fault = ""
+        # Whether the tooth has touched the active face since it became active (it starts
+        # on the entrance face): a face passed in free flight untouched is a skipped tooth.
+        self.engaged = True
         self.log = log
         self.t_base = 0.0
         self.t_mark = -1.0  # offset of the first regime change or impact (set by the caller)
@@ -664,6 +669,7 @@ class VergeCore:
             psi = y[2] - TWO_PI + lam
             self.psic -= lam
             self.face = ENTRANCE
+        self.engaged = False
         return [y[0], y[1], psi, y[3], y[4]]
 
     def _reindex_and_free(self, y: list[float], t: float) -> list[float]:
@@ -675,6 +681,17 @@ class VergeCore:
     def _reindex_free(self, y: list[float], t: float) -> list[float]:
         if self.log is not None:
             self.log(self.t_base + t, FREE, FREE, "tip passed the face end in free flight")
+        if not self.engaged:
+            # The wheel ran past a face it never touched: the escapement does not escape,
+            # it lets teeth through, and nothing after this instant is the design's motion.
+            face = "entrance" if self.face == ENTRANCE else "exit"
+            self.fault = (
+                f"the escapement skips teeth: at t = {self.t_base + t:.6g} s a tooth passed "
+                f"the {face} face in free flight without touching it (a design that "
+                "does not escape; mechcosim check names the rule)"
+            )
+            self.halted = True
+            return y
         return self._free_entry(self._reindex(y), t)
 
     def _free_entry(self, y: list[float], t: float) -> list[float]:
@@ -706,6 +723,7 @@ class VergeCore:
         vc, a1p, d1p = self.closing_speed(y)
         if vc < -self.v_capture:
             return y  # separating: stays free (f turns positive again)
+        self.engaged = True
         if vc > self.v_capture:
             phi_f, psi_f = impact_map(
                 y[1], y[3], a1p, d1p, self.k.ip, self.train.impact_inertia(y[0]), self.k.e_rest
@@ -847,24 +865,9 @@ class VergeEscapement(Component):
     PORTS = {"escape_wheel": ESCAPE_WHEEL_PORT}
 
     VARIABLES = (
-        Variable(
-            "mu1", "parameter", "1", M739.mu1, "friction, tooth-face and verge pivot", min=0.0
-        ),
-        Variable(
-            "mu", "parameter", "1", M739.mu, "friction, escape-wheel pivot (train mu)", min=0.0
-        ),
-        # The model takes |omega| (spin in either sense gives the same motion): spin >= 0.
-        Variable("spin", "parameter", "rad/s", M739.omega, "fuze spin rate omega", min=0.0),
-        Variable(
-            "e_rest", "parameter", "1", M739.e_rest, "coefficient of restitution", min=0.0, max=1.0
-        ),
-        Variable(
-            "phi_local_start",
-            "parameter",
-            "rad",
-            M739.phi_start,
-            "escape-wheel angle on the entrance face at phi = 0",
-        ),
+        # The SANDA2V deck's escapement quantities (cards 1-2, the pallet's body) and the
+        # train geometry that places the pallet pivot in the fuze body (B1-B31).
+        *deck_variables(VERGE),
         Variable(
             "v_capture",
             "parameter",
@@ -883,26 +886,6 @@ class VergeEscapement(Component):
             "(spent: the step is discarded, with a message)",
             "Integer",
             min=1.0,
-        ),
-        Variable(
-            "center_distance",
-            "parameter",
-            "m",
-            M739.a,
-            "escapement centre distance O_p-O_s (pallet pivot to escape-wheel pivot)",
-            # Where the pallet pivot can sit at R4 from the spin axis and the tooth tips
-            # can leave the faces (escapement_data): set by the part dimensions.
-            min=max(abs(M739.r3 - M739.r4), abs(M739.b - M739.c)),
-            max=min(M739.r3 + M739.r4, M739.b + M739.c),
-        ),
-        Variable(
-            "pallet_inertia",
-            "parameter",
-            "kg.m2",
-            M739.ip,
-            "verge (pallet) moment of inertia about its pivot, I_p",
-            min=0.0,
-            exclusive_min=True,
         ),
         Variable("phi", "input", "rad", 0.0, "cumulative escape-wheel angle", sampled=True),
         Variable("phi_dot", "input", "rad/s", 0.0, "escape-wheel speed", sampled=True),
@@ -1088,7 +1071,9 @@ class VergeEscapement(Component):
         self.check_parameters()  # a NaN spin or restitution is named here, not met later
         self._control = integration_step_control(self, STATE_SCALES)
         self._h_next = 0.0
-        data = escapement_data(self.center_distance, self.phi_local_start, self.pallet_inertia)
+        data = design_of(self, VERGE)
+        if self.check_design:
+            raise_first(verge_violations(data))  # a broken design is refused, not run
         k = VergeConstants(data, self.mu1, self.mu, self.spin, self.e_rest)
         self._held = HeldTrain(self.J_ref, self.T_ref, self.c_load, self.J_stot)
         self._core = VergeCore(

@@ -38,35 +38,56 @@ class FuzeAngles:
     gamma_pp: float  # gamma_p': angle from +x' to the outward radial at O_p
 
 
-def fuze_angles(d: M739Data) -> FuzeAngles:
-    """App B, B1-B31 (s6 = +1 for configuration 1, -1 for configuration 2)."""
+@dataclass(frozen=True)
+class TrainAngles:
+    """The train's pivot polar angles and mesh centre-line directions [rad] (B1-B10)."""
+
+    gamma2: float
+    gamma3: float
+    gamma3p: float
+    delta2: float
+    delta3: float
+    beta1: float  # direction O1 -> O2
+    beta2: float  # direction O2 -> O3
+
+
+def train_angles(d: M739Data) -> TrainAngles:
+    """App B, B1-B10: the rotor, gear-2 and escape-wheel pivots (s6 = +1 for configuration
+    1, -1 for configuration 2); the pallet pivot does not enter them."""
     s6 = 1.0 if d.config == 1 else -1.0
     c12 = d.rp1_cap + d.rp2  # centre distance, mesh 1
     c23 = d.rp2_cap + d.rp3  # centre distance, mesh 2
     gamma2 = s6 * math.acos((d.r1**2 + d.r2**2 - c12**2) / (2 * d.r1 * d.r2))
     gamma3p = math.acos((d.r2**2 + d.r3**2 - c23**2) / (2 * d.r2 * d.r3))
     gamma3 = gamma2 + s6 * gamma3p
-    gamma4p = math.acos((d.r3**2 + d.r4**2 - d.a**2) / (2 * d.r3 * d.r4))
-    gamma4 = gamma3 + s6 * gamma4p
     delta2 = math.acos((c12**2 + d.r1**2 - d.r2**2) / (2 * d.r1 * c12))
     delta3 = math.acos((c23**2 + d.r2**2 - d.r3**2) / (2 * d.r2 * c23))
-    delta4 = math.acos((d.a**2 + d.r3**2 - d.r4**2) / (2 * d.a * d.r3))
     beta1 = math.pi - s6 * delta2
     beta2 = gamma2 + math.pi - s6 * delta3
-    beta3 = gamma3 + math.pi - s6 * delta4
+    return TrainAngles(gamma2, gamma3, gamma3p, delta2, delta3, beta1, beta2)
+
+
+def fuze_angles(d: M739Data) -> FuzeAngles:
+    """App B, B1-B31 (s6 = +1 for configuration 1, -1 for configuration 2)."""
+    s6 = 1.0 if d.config == 1 else -1.0
+    t = train_angles(d)
+    gamma4p = math.acos((d.r3**2 + d.r4**2 - d.a**2) / (2 * d.r3 * d.r4))
+    gamma4 = t.gamma3 + s6 * gamma4p
+    delta4 = math.acos((d.a**2 + d.r3**2 - d.r4**2) / (2 * d.a * d.r3))
+    beta3 = t.gamma3 + math.pi - s6 * delta4
     # B14 (configuration 1) / B26 (configuration 2).
     gamma_pp = delta4 + gamma4p if d.config == 1 else TWO_PI - delta4 - gamma4p
     return FuzeAngles(
-        gamma2,
-        gamma3,
+        t.gamma2,
+        t.gamma3,
         gamma4,
-        gamma3p,
+        t.gamma3p,
         gamma4p,
-        delta2,
-        delta3,
+        t.delta2,
+        t.delta3,
         delta4,
-        beta1,
-        beta2,
+        t.beta1,
+        t.beta2,
         beta3,
         gamma_pp,
     )

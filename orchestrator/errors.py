@@ -9,7 +9,7 @@ class ScenarioError(ValueError):
     """A scenario file is wrong; raised before anything runs."""
 
     def __init__(self, path: Path | str, key: str, message: str) -> None:
-        self.path, self.key = str(path), key
+        self.path, self.key, self.message = str(path), key, message
         super().__init__(f"{path}: [{key}] {message}" if key else f"{path}: {message}")
 
 

@@ -18,6 +18,7 @@ from fmus.build import BuildError, build_fmu
 from fmus.ports import PortError, PortSide, join_ports
 from fmus.registry import FMU_RECORDS
 from orchestrator.errors import ScenarioError
+from orchestrator.lazy import LazyRegistry
 from orchestrator.master_settings import (
     ALGORITHMS,
     COMMON_KEYS,
@@ -316,7 +317,9 @@ class _Loader:
             if section not in raw:
                 raise self.fail(section, "missing section")
         head = self.table(raw["scene"], "scene")
-        self.check_keys(head, "scene", {"name", "description", "start", "stop", "stop_when"})
+        self.check_keys(
+            head, "scene", {"name", "description", "start", "stop", "stop_when", "design"}
+        )
         name = self.scene_name(self.string(head, "name", "scene.name"))
         description = head.get("description", "")
         if not isinstance(description, str):
@@ -329,6 +332,11 @@ class _Loader:
             raise self.fail("scene.stop", f"must be later than scene.start ({start} s), got {stop}")
         self.span = (start, stop)  # a signal refuses a run past its span
         shared = self.table(raw.get("parameters", {}), "parameters")
+        # A design file gives the mechanism's quantities; the scene's own [parameters]
+        # (its operating point: spin, friction, ...) win over the file's.
+        self.design_keys = {n: (self.path, f"parameters.{n}") for n in shared}
+        design = self.design(head["design"]) if "design" in head else {}
+        shared = {**design, **shared}
         fmus = self.fmus(self.table(raw["fmus"], "fmus"), shared)
         stop_when = self.stop_when(head["stop_when"], fmus) if "stop_when" in head else None
         connections = self.connections(raw.get("connections", []), fmus)
@@ -342,7 +350,7 @@ class _Loader:
         self.report_needs(headline, family_name, reference, options, fmus, record)
         sweep = self.sweep(raw["sweep"], fmus) if "sweep" in raw else None
         study = self.study(raw["study"], fmus) if "study" in raw else None
-        return Scene(
+        scene = Scene(
             path=self.path,
             name=name,
             description=description,
@@ -363,6 +371,53 @@ class _Loader:
             sweep=sweep,
             study=study,
         )
+        self.check_design(scene)
+        return scene
+
+    def design(self, text: Any) -> dict[str, Any]:
+        """The quantities of a design file (``scene.design``, relative to the scene): its
+        [design] table, whose sub-tables (e.g. one per input card) only group them."""
+        if not isinstance(text, str) or not text.strip():
+            raise self.fail("scene.design", f"expected the path of a design file, got {text!r}")
+        path = (self.path.parent / text).resolve()
+        if path == self.path.resolve():
+            raise self.fail("scene.design", "names the scene file itself; expected a design file")
+        raw = read_toml(path)
+        if not isinstance(raw.get("design"), dict):
+            raise ScenarioError(path, "design", "missing; expected a [design] table")
+        out: dict[str, Any] = {}
+
+        def take(node: dict[str, Any], key: str) -> None:
+            for name, value in node.items():
+                dotted = f"{key}.{name}"
+                if name in ("name", "description", "source") and key == "design":
+                    if not isinstance(value, str):
+                        raise ScenarioError(path, dotted, f"expected text, got {value!r}")
+                    continue
+                if isinstance(value, dict) and not _is_value_table(value):
+                    take(value, dotted)
+                    continue
+                if name in out:
+                    raise ScenarioError(
+                        path, dotted, f"{name} is stated twice ({self.design_keys[name][1]})"
+                    )
+                out[name] = value
+                self.design_keys[name] = (path, dotted)
+
+        take(raw["design"], "design")
+        return out
+
+    def check_design(self, scene: Scene) -> None:
+        """The family's consistency rules of the scene's design (the first broken one)."""
+        if scene.family is None:
+            return
+        check = family(scene.family).design_check
+        if check is None:
+            return
+        problems = LazyRegistry({"check": check})["check"](scene)
+        if problems:
+            more = f" (and {len(problems) - 1} more)" if len(problems) > 1 else ""
+            raise self.fail("parameters", f"{problems[0]}{more}")
 
     def stop_when(self, node: Any, fmus: dict[str, FmuSpec]) -> StopCondition:
         key = "scene.stop_when"
@@ -398,8 +453,16 @@ class _Loader:
                 raise self.fail(f"{key}.fmu", str(exc)) from None
             params = self.values(entry.get("parameters", {}), f"{key}.parameters", model)
             for name, value in shared.items():
-                if _takes(component, model, shared_parameters().get(name)):
-                    params[name] = self.value(value, f"parameters.{name}", model.variables[name])
+                if _takes(component, model, shared_parameters().get(name)) or _designs(
+                    component, name
+                ):
+                    if name in params:
+                        raise self.fail(
+                            f"{key}.parameters.{name}",
+                            f"{name} is a quantity of the design, stated for the scene "
+                            f"({self.design_keys[name][1]}): state it once",
+                        )
+                    params[name] = self.shared_value(name, value, model.variables[name])
             inputs = self.values(entry.get("inputs", {}), f"{key}.inputs", model)
             signals = {n: inputs.pop(n) for n, v in list(inputs.items()) if isinstance(v, Signal)}
             # Initialization sees each signal's value at the start (before a jump there).
@@ -410,6 +473,14 @@ class _Loader:
             )
         self.check_shared(node, shared, specs)
         return specs
+
+    def shared_value(self, name: str, value: Any, var: VariableInfo) -> Any:
+        """A [parameters] or design-file value, its error naming the file it came from."""
+        path, key = self.design_keys.get(name, (self.path, f"parameters.{name}"))
+        try:
+            return self.value(value, key, var)
+        except ScenarioError as exc:
+            raise ScenarioError(path, key, exc.message) from None
 
     def check_shared(
         self, node: dict[str, Any], shared: dict[str, Any], fmus: dict[str, FmuSpec]
@@ -432,8 +503,17 @@ class _Loader:
                         f"{', '.join(sorted(taken[name].components))}: state it once for the "
                         f"scene as parameters.{name} (a [parameters] table)",
                     )
+        designed = {n for spec in fmus.values() for n in shared if _designs(spec.component, n)}
         for name in shared:
-            if name not in taken:
+            if name not in taken and name not in designed:
+                path, key = self.design_keys.get(name, (self.path, f"parameters.{name}"))
+                if path != self.path:
+                    raise ScenarioError(
+                        path,
+                        key,
+                        "no FMU of the scene takes it (a design quantity of another "
+                        "mechanism, or a misspelt name)",
+                    )
                 raise self.fail(
                     f"parameters.{name}",
                     "not a parameter the scene's FMUs share (set it in [fmus.<instance>] "
@@ -454,7 +534,7 @@ class _Loader:
             return [
                 (instance, "parameters", parts[1])
                 for instance, spec in fmus.items()
-                if _takes(spec.component, spec.model, shared)
+                if _takes(spec.component, spec.model, shared) or _designs(spec.component, parts[1])
             ]
         return []
 
@@ -908,6 +988,18 @@ class _Loader:
         if isinstance(value, bool) or not isinstance(value, int | float):
             raise self.fail(f"sweep.values[{k}]", f"expected a number, got {value!r}")
         return float(value)
+
+
+def _designs(component: str | None, name: str) -> bool:
+    """Whether one of our FMUs (``component``) declares ``name`` a design quantity."""
+    if component is None or component not in FMU_RECORDS:
+        return False
+    return any(v.name == name and v.design for v in FMU_RECORDS[component].variables)
+
+
+def _is_value_table(node: dict[str, Any]) -> bool:
+    """A table that is one value (a signal, a distribution), not a group of quantities."""
+    return any(k in node for k in ("table", "csv", "step", "ramp", "value", "unit"))
 
 
 def _takes(component: str | None, model: ModelInfo, shared: SharedParameter | None) -> bool:

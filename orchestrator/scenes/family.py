@@ -112,6 +112,8 @@ class SceneFamily:
     reference: (scene) -> Reference, the monolithic yardstick of the coupling error
     shared: the parameters its FMUs share (they hold in every scene with those FMUs)
     drawing: (scene, path) -> None, writing a PNG of the scene's design to scale
+    design_check: (scene) -> [message], every broken consistency rule of the scene's design
+        (checked when the scene is loaded: a broken design never runs)
     """
 
     needs: Needs = field(default_factory=Needs)
@@ -120,3 +122,4 @@ class SceneFamily:
     reference: str | None = None
     shared: tuple[SharedParameter, ...] = ()
     drawing: str | None = None
+    design_check: str | None = None

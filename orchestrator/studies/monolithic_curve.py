@@ -128,21 +128,11 @@ def _parameter(scene: Scene, instance: str, name: str) -> float:
 
 
 def _m739(scene: Scene) -> Callable[[float], Any]:
-    # The same arguments as the family's reference (orchestrator/scenes/m739/report.py);
-    # tests/orchestrator/test_work_precision_monolithic.py checks that they stay so.
-    from components.verge_escapement import escapement_data
+    # The same arguments as the family's reference (orchestrator/scenes/m739/report.py).
     from orchestrator.scenes.m739.monolithic import run_m739
-    from orchestrator.scenes.m739.report import escapement_arguments, instance_names
+    from orchestrator.scenes.m739.report import monolithic_arguments
 
-    train, verge = instance_names(scene)
-    kwargs = {
-        **escapement_arguments(scene, train, verge),
-        "indexing": int(_parameter(scene, train, "indexing")),
-        "data": escapement_data(
-            _parameter(scene, verge, "center_distance"),
-            pallet_inertia=_parameter(scene, verge, "pallet_inertia"),
-        ),
-    }
+    kwargs = monolithic_arguments(scene)
     return lambda tolerance: run_m739(tolerance=tolerance, **kwargs)
 
 

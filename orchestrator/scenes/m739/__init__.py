@@ -1,6 +1,7 @@
 """The M739 S&A: involute gear train and straight-sided verge runaway escapement (Lowen &
 Tepper 1982, *Computer Simulation of Artillery S&A Mechanism*)."""
 
+from components.sanda2v_deck import DECK, SHARED
 from orchestrator.scenes.family import Needs, Option, Role, SceneFamily, SharedParameter
 
 _ESCAPEMENT_FORCES = ("phi", "phi_dot", "regime", "F12", "F23", "FF12", "FF23")
@@ -29,9 +30,22 @@ def escapement_shared(train_component: str) -> tuple[SharedParameter, ...]:
     )
 
 
+def deck_shared() -> tuple[SharedParameter, ...]:
+    """The rest of what the M739 train and verge both take: the train geometry that places
+    the pallet pivot in the fuze body, and the escape-wheel pivot radius."""
+    pair = frozenset({"GearTrain", "VergeEscapement"})
+    return tuple(
+        SharedParameter(e.name, pair, f"the design's {e.meaning} [{e.source}]")
+        for e in DECK
+        if e.name in SHARED and e.name not in ("spin", "mu")
+    )
+
+
 FAMILY = SceneFamily(
     needs=escapement_needs("GearTrain"),
-    shared=escapement_shared("GearTrain"),
+    shared=escapement_shared("GearTrain") + deck_shared(),
+    design_check="orchestrator.scenes.m739.design:check",
+    drawing="orchestrator.scenes.m739.drawing:draw",
     analysis="orchestrator.scenes.m739.report:analyse",
     plot="orchestrator.scenes.m739.report:plot",
     reference="orchestrator.scenes.m739.report:reference",

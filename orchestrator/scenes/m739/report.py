@@ -18,9 +18,10 @@ import numpy as np
 
 from components.m739_data import LBF, M739
 from components.units import RPM_PER_RAD_S
-from components.verge_escapement import FREE, REGIME_NAMES, escapement_data
+from components.verge_escapement import FREE, REGIME_NAMES
 from orchestrator.scenario import Scene
 from orchestrator.scenes.family import Quantity, Reference, quantity
+from orchestrator.scenes.m739.design import scene_design
 from orchestrator.scenes.m739.monolithic import run_m739
 
 
@@ -49,8 +50,15 @@ def escapement_arguments(scene: Scene, train: str, verge: str) -> dict[str, floa
 
 
 def _arming_angle(scene: Scene) -> float:
+    """The scene's stop condition (the design's arming angle, which the loader checked it
+    against), else the design's arming angle."""
     cond = scene.stop_when
-    return cond.threshold if cond is not None else M739.phi_cut
+    if cond is not None:
+        return cond.threshold
+    train, _ = instance_names(scene)
+    if "arming_angle" in {v.name for v in scene.component_class(train).VARIABLES}:
+        return _parameter(scene, train, "arming_angle")
+    return M739.phi_cut
 
 
 def crossing_time(t: np.ndarray, x: np.ndarray, level: float, rising: bool = True) -> float | None:
@@ -127,19 +135,20 @@ def _why_not_armed(scene: Scene, col: dict[str, np.ndarray], train: str) -> str:
     return f"stop time {scene.stop:.6g} s reached before the arming angle"
 
 
-def reference(scene: Scene) -> Reference:
-    """The monolithic M739 model with the scene's physics, as the yardstick."""
+def monolithic_arguments(scene: Scene) -> dict[str, Any]:
+    """What ``run_m739`` takes for the scene: its operating point and its whole design."""
     train, verge = instance_names(scene)
-    data = escapement_data(
-        _parameter(scene, verge, "center_distance"),
-        pallet_inertia=_parameter(scene, verge, "pallet_inertia"),
-    )
-    result = run_m739(
+    return {
         **escapement_arguments(scene, train, verge),
-        indexing=int(_parameter(scene, train, "indexing")),
-        data=data,
-    )
-    return reference_from(result, train, verge)
+        "indexing": int(_parameter(scene, train, "indexing")),
+        "data": scene_design(scene),
+    }
+
+
+def reference(scene: Scene) -> Reference:
+    """The monolithic M739 model with the scene's physics and design, as the yardstick."""
+    train, verge = instance_names(scene)
+    return reference_from(run_m739(**monolithic_arguments(scene)), train, verge)
 
 
 def reference_from(result: Any, train: str, verge: str) -> Reference:
