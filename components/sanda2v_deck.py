@@ -540,10 +540,18 @@ BY_NAME = {e.name: e for e in DECK}
 SHARED = tuple(e.name for e in DECK if e.users == BOTH)
 
 
+#: The operating point (friction, spin, restitution): the quantities a scene varies most,
+#: declared first.
+OPERATING = ("mu1", "mu", "spin", "e_rest")
+
+
 def deck_variables(user: str) -> tuple[Variable, ...]:
-    """The design parameters of one FMU (``TRAIN`` or ``VERGE``), in deck order, and
-    whether it checks them."""
-    return (*(e.variable() for e in DECK if user in e.users), CHECK_DESIGN)
+    """The design parameters of one FMU (``TRAIN`` or ``VERGE``): its operating point, then
+    the drawing's quantities in deck order, and whether it checks them."""
+    mine = [e for e in DECK if user in e.users]
+    first = [e for name in OPERATING for e in mine if e.name == name]
+    rest = [e for e in mine if e.name not in OPERATING]
+    return (*(e.variable() for e in first + rest), CHECK_DESIGN)
 
 
 def design_of(component: Any, user: str) -> M739Data:
