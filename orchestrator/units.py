@@ -7,8 +7,17 @@ from functools import cache
 
 import pint
 
+from components.units import INCH, LBF
+
 UREG = pint.UnitRegistry()
 _POWER = re.compile(r"([A-Za-z]+)(-?\d+)")
+#: The sources' mass and inertia units, converted with the factors the physics defines its
+#: data with (components.units), so that a deck typed in them gives the built-in values to
+#: the bit (pint's pound-force differs from the exact 4.4482216152605 N in the last digit).
+_EXACT = {
+    UREG.Unit("lbf*s**2/in"): ("kg", LBF / INCH),
+    UREG.Unit("lbf*in*s**2"): ("kg*m**2", LBF * INCH),
+}
 
 
 @cache
@@ -43,8 +52,17 @@ def to_si(value: object, fmi_unit: str) -> float:
             return float(quantity)
         if quantity.unitless:  # a bare number written as text ("2.5", "nan"): taken as SI
             return float(quantity.magnitude)
+        exact = _EXACT.get(quantity.units)
+        if exact is not None and UREG.Unit(exact[0]) == target:
+            return float(quantity.magnitude) * exact[1]
         return float(quantity.to(target).magnitude)
     except pint.DimensionalityError:
+        hint = (
+            " (the sources' lb of a mass or an inertia is a pound-force: lbf*s^2/in, lbf*in*s^2)"
+            if re.search(r"\blb\b", value)
+            else ""
+        )
         raise ValueError(
-            f"{value!r} has units of {quantity.units:~}, which cannot be converted to {fmi_unit}"
+            f"{value!r} has units of {quantity.units:~}, which cannot be converted to "
+            f"{fmi_unit}{hint}"
         ) from None
