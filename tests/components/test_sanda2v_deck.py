@@ -144,3 +144,9 @@ def test_a_wheel_that_skips_teeth_ends_the_reference_run() -> None:
     assert not result.armed and result.impacts == 0
     assert result.reason.startswith("the escapement skips teeth: at t = 0.000694")
     assert math.isclose(result.t_end, 6.94e-4, rel_tol=1e-2)
+
+
+def test_the_design_page_tabulates_every_quantity() -> None:
+    page = (Path(__file__).resolve().parents[2] / "docs" / "designs.md").read_text()
+    for e in DECK:
+        assert f"| {e.card} | {e.symbol} | `{e.name}` |" in page, e.name
