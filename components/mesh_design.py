@@ -202,16 +202,17 @@ def check_involute_design(mesh: InvoluteMesh, rasfact: float = 0.883) -> list[Vi
             f"PSUBD = {pd * INCH:g} /in, {degrees('THETAD', phi)}); expected equal within "
             f"{tol / INCH:.1e} in",
         ))  # fmt: skip
-    # Both members share the base pitch (the gear's tooth number a whole number).
+    # Both members share the base pitch of the diametral pitch, pi cos(THETAD) / PSUBD (the
+    # pinion's, by the rule above): the gear's tooth number is a whole number.
     n_gear = gear_tooth_number(mesh)
-    pb_pinion = 2.0 * math.pi * rb / mesh.n_pinion
+    pb_pitch = math.pi * cos_phi / pd
     pb_gear = 2.0 * math.pi * big_rb / n_gear
-    tol_pb = 2.0 * math.pi * tol * (1.0 / n_gear + 1.0 / mesh.n_pinion)
-    if abs(pb_gear - pb_pinion) > tol_pb:
+    tol_pb = 2.0 * math.pi * tol / n_gear
+    if abs(pb_gear - pb_pitch) > tol_pb:
         out.append(Violation(
             "equal base pitch",
             f"{inches('PB gear = 2 pi CAPRP cos(THETAD) / NG', pb_gear)} (NG = {n_gear}) against "
-            f"{inches('PB pinion = 2 pi RP cos(THETAD) / NP', pb_pinion)}; expected equal "
+            f"{inches('PB = pi cos(THETAD) / PSUBD', pb_pitch)} (the pinion's); expected equal "
             f"within {tol_pb / INCH:.1e} in",
         ))  # fmt: skip
     for who, ro, rb_, sym, sym_b in (
@@ -242,12 +243,13 @@ def check_involute_design(mesh: InvoluteMesh, rasfact: float = 0.883) -> list[Vi
         rf = math.inf
     u = 1.0 - b / rp
     if u <= rasfact and not rf < rp_op:
+        form = inches("RF", rf) if math.isfinite(rf) else "no root RF of eq. 49 below RP"
         out.append(Violation(
             "undercut",
             f"the pinion is undercut ({plain('U = 1 - B / RP', u, 4)} <= "
-            f"{plain('RASFACT', rasfact, 4)}) with {inches('RF', rf)} against the operating "
-            f"{inches('RP', rp_op)}; expected the true involute (from RF, eq. 49) to reach "
-            "below the pitch point",
+            f"{plain('RASFACT', rasfact, 4)}, {inches('B', b)}) with {form} against the "
+            f"operating {inches('RP', rp_op)}; expected the true involute (from RF, eq. 49) "
+            "to reach below the pitch point",
         ))  # fmt: skip
         return out
     s_gear = math.sqrt(mesh.gear_outside_radius**2 - big_rb**2)
@@ -256,6 +258,7 @@ def check_involute_design(mesh: InvoluteMesh, rasfact: float = 0.883) -> list[Vi
     tan_op = math.tan(op)
     pz_form, pz_tip = rb * tan_op - s_form, s_gear - big_rb * tan_op  # eqs. 4, 8
     path = s_gear + s_pin - (big_rb + rb) * tan_op if pz_form > pz_tip else s_pin - s_form
+    pb_pinion = 2.0 * math.pi * rb / mesh.n_pinion  # PB as ISAD computes it
     cr = path / pb_pinion  # eqs. 25/26
     if not 1.0 < cr < 2.0:
         out.append(Violation(
