@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -34,6 +35,10 @@ from components.mesh_efficiency_data import (
     INCH,
     INVOLUTE_MESHES,
 )
+from orchestrator.errors import ScenarioError
+from orchestrator.run import run_scene
+from orchestrator.scenario import load_scene
+from orchestrator.scenes.gear_mesh.report import mesh_scene
 
 STORED = {table - 4: mesh for table, mesh in INVOLUTE_MESHES.items()}  # mesh = k: Table k + 4
 
@@ -275,3 +280,86 @@ def test_initialization_refuses_a_broken_pair() -> None:
         c.initialize(0.0)
     # a stored mesh ignores the design parameters
     GearMesh(mesh=2, center_distance=0.54 * INCH).initialize(0.0)
+
+
+# -- scenes: the user pair entered in inches and degrees, and the drawing ---------------------
+SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
+
+
+def test_user_pair_scene_runs_as_the_stored_mesh(tmp_path: Path, fmu_cache: Path) -> None:
+    """Table 15's inputs typed as the report prints them give the stored mesh 2 (physical end
+    of dual contact) bit for bit: every recorded sample and event."""
+    user = run_scene(load_scene(SCENARIOS / "mesh_user_pair.toml"), output_dir=tmp_path / "u",
+                     cache_dir=fmu_cache, show_progress=False)  # fmt: skip
+    stored_scene = load_scene(
+        SCENARIOS / "mesh_efficiency.toml", {"fmus.mesh.parameters.printed_run": 0}
+    )
+    stored = run_scene(stored_scene, output_dir=tmp_path / "s", cache_dir=fmu_cache,
+                       show_progress=False)  # fmt: skip
+    assert user.status == stored.status == "completed"
+    for name in ("timeseries.csv", "events.csv"):
+        assert (tmp_path / "u" / name).read_bytes() == (tmp_path / "s" / name).read_bytes()
+    assert user.accuracy["headline_error"] < user.scene.error_bound
+    # Table 15 run with the physical ALFIN 15.215 deg: minimum .8666 at mu = 0.1 (the dual
+    # plateau of Appendix E), the continuous cycle mean .8735 (K = 25 gives .8734)
+    assert user.value("min_efficiency") == pytest.approx(0.8666, abs=1e-4)
+    assert user.value("mean_efficiency") == pytest.approx(0.8734, abs=2e-4)
+
+
+def test_a_broken_user_pair_is_refused_in_one_line() -> None:
+    scene = load_scene(
+        SCENARIOS / "mesh_user_pair.toml", {"fmus.mesh.parameters.center_distance": "0.54 in"}
+    )
+    with pytest.raises(ScenarioError) as err:
+        mesh_scene(scene)
+    text = str(err.value)
+    assert "fmus.mesh.parameters" in text and "\n" not in text
+    assert "design rule 'centre distance' broken: CD = 0.54000 in" in text
+
+
+def _radii(fig) -> set[float]:
+    return {
+        round(p.get_radius(), 9) for ax in fig.axes for p in ax.patches if hasattr(p, "get_radius")
+    }
+
+
+@pytest.mark.parametrize(
+    "name", ["mesh_efficiency.toml", "mesh_user_pair.toml", "mesh_efficiency_clock.toml"]
+)
+def test_drawing_is_written_to_scale(name: str, tmp_path: Path) -> None:
+    import matplotlib.pyplot as plt
+
+    from orchestrator.scenes import DRAWINGS
+    from orchestrator.scenes.gear_mesh.drawing import figure
+
+    scene = load_scene(SCENARIOS / name)
+    DRAWINGS["gear_mesh"](scene, tmp_path / "pair.png")
+    assert (tmp_path / "pair.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert (tmp_path / "pair.png").stat().st_size > 20_000
+    fig = figure(scene)
+    radii = _radii(fig)
+    plt.close(fig)
+    if name == "mesh_efficiency_clock.toml":
+        # M739-like mesh 1: 64 : 9 on centre distance 0.4701 in (11.941 mm)
+        b = 0.4701 * 25.4
+        assert round(b * 64 / 73, 9) in radii and round(b * 9 / 73, 9) in radii
+        return
+    # Table 15 (p. 31): base radii .4229 / .0940 in, outside .4625 / .1125 in, operating pitch
+    # radii .45082 / .10018 in, drawn in mm
+    mm = [r / 25.4 for r in radii]
+    for printed, digits in ((0.4229, 4), (0.0940, 4), (0.4625, 4), (0.1125, 4), (0.45082, 5),
+                            (0.10018, 5)):  # fmt: skip
+        assert any(round(r, digits) == printed for r in mm), printed
+
+
+def test_drawing_of_a_tables_1_4_clock_mesh(tmp_path: Path) -> None:
+    import matplotlib.pyplot as plt
+
+    from orchestrator.scenes.gear_mesh.drawing import figure
+
+    scene = load_scene(SCENARIOS / "mesh_efficiency_clock.toml", {
+        "fmus.mesh.parameters.clock_mesh": 0})  # fmt: skip
+    fig = figure(scene)
+    radii = _radii(fig)
+    plt.close(fig)
+    assert {round(0.360 * 25.4, 9), round(0.090 * 25.4, 9)} <= radii  # Table 1 pitch radii
