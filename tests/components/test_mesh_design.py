@@ -12,7 +12,13 @@ import numpy as np
 import pytest
 
 from components.design_rules import DesignError
-from components.gear_mesh import ClockTableModel, GearMesh, InvoluteModel, build_mesh
+from components.gear_mesh import (
+    REGIME_NAMES,
+    ClockTableModel,
+    GearMesh,
+    InvoluteModel,
+    build_mesh,
+)
 from components.mesh_design import (
     CLOCK_DESIGN,
     INVOLUTE_DESIGN,
@@ -25,6 +31,7 @@ from components.mesh_design import (
 from components.mesh_efficiency import (
     ClockMeshModel,
     clock_sweep,
+    clock_table_cycle_summary,
     involute_cycle,
     involute_cycle_summary,
     involute_efficiency_curve,
@@ -152,7 +159,10 @@ def test_clock_table_entered_gives_the_library_results(table: int) -> None:
     _run(c, n=20, h=2.0 * m.cycle / c.speed / 20)  # two gear pitches
     assert c.mesh_cycles == pytest.approx(2.0, rel=1e-9)
     assert c.driven_angle == pytest.approx(4 * math.pi / mesh.n_pinion, rel=1e-9)
-    assert 0.0 < c.cycle_efficiency < 1.0
+    # two whole pitches at constant load: the work ratio of the closed form's quadrature
+    summary = clock_table_cycle_summary(library, 0.1)
+    assert c.cycle_efficiency == pytest.approx(summary.work_efficiency, rel=1e-9)
+    assert {REGIME_NAMES[r] for r in m.regimes} >= {"round-on-flank-recess"}
 
 
 # -- every stored mesh passes every rule ------------------------------------------------------
