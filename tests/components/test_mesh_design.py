@@ -45,7 +45,7 @@ from components.mesh_efficiency_data import (
 from orchestrator.errors import ScenarioError
 from orchestrator.run import run_scene
 from orchestrator.scenario import load_scene
-from orchestrator.scenes.gear_mesh.report import mesh_scene
+from orchestrator.scenes.gear_mesh.report import check, mesh_scene
 
 STORED = {table - 4: mesh for table, mesh in INVOLUTE_MESHES.items()}  # mesh = k: Table k + 4
 
@@ -325,6 +325,8 @@ def test_a_broken_user_pair_is_refused_in_one_line() -> None:
     text = str(err.value)
     assert "fmus.mesh.parameters" in text and "\n" not in text
     assert "design rule 'centre distance' broken: CD = 0.54000 in" in text
+    assert [v.rule for v in check(scene)] == ["centre distance"]
+    assert check(load_scene(SCENARIOS / "mesh_user_pair.toml")) == []
 
 
 def _radii(fig) -> set[float]:

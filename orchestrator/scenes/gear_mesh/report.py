@@ -36,6 +36,7 @@ from typing import Any
 import numpy as np
 
 from components.base import ComponentError
+from components.design_rules import Violation
 from components.gear_mesh import (
     REGIME_NAMES,
     ClockModel,
@@ -45,6 +46,7 @@ from components.gear_mesh import (
     MeshModel,
     build_mesh,
 )
+from components.mesh_design import check_mesh_design
 from components.mesh_efficiency import (
     CycleSummary,
     clock_table_cycle_summary,
@@ -119,6 +121,18 @@ def mesh_scene(scene: Scene) -> MeshScene:
     connected = any(c.target == (inst, "load_torque") for c in scene.connections)
     theta0 = model.cycle_start + params["phase0"] * model.cycle
     return MeshScene(inst, params, float(load), connected, model, scene.start, theta0)
+
+
+def check(scene: Scene) -> list[Violation]:
+    """Every broken consistency rule of the user pair the scene's GearMesh selects (empty for
+    a stored mesh): components.mesh_design.check_mesh_design on its parameters."""
+    names = [n for n, spec in scene.fmus.items() if spec.component == "GearMesh"]
+    out: list[Violation] = []
+    for name in names:
+        params = {v.name: float(v.start) for v in GearMesh.variables("parameter")}
+        params.update(scene.fmus[name].parameters)
+        out.extend(check_mesh_design(params))
+    return out
 
 
 def _whole_cycles(ms: MeshScene, theta_first: float, theta_last: float) -> tuple[float, int]:
