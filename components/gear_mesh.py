@@ -19,6 +19,12 @@ Mesh models (parameter ``model``):
    derived round-on-round / round-on-flank efficiency (mesh_efficiency.train_mesh_efficiency,
    the statics of ClockMeshModel), pivot radii of the M739 input data.
 
+A user pair (components.mesh_design): ``mesh = 0`` takes the involute pair from the design
+parameters (every ISAD input, Tepper 1981 Apps. C-D, and which member drives), ``clock_mesh = 0``
+the clock mesh in the form of Tables 1-4 (mesh_efficiency.ClockMeshModel, the gear drives).  Their
+defaults are Table 6 as published and Table 1; initialization refuses a pair that breaks a
+consistency rule (mesh_design.check_mesh_design).
+
 Angles are counted in each member's own sense of rotation (both increase; the meshes are
 external, so the members turn opposite ways), R > 0, and the load torque is positive when it
 resists the driven member's motion.  Involute: the driver angle is the driver roll angle alpha_1
@@ -48,16 +54,30 @@ from __future__ import annotations
 
 import bisect
 import math
+from collections.abc import Mapping
 from functools import cache
 
 import numpy as np
 
 from .base import COMMON_OUTPUTS, Component, ComponentError, SnapshotPlan, Variable
 from .clock_train_kinematics import M739_MESH1, M739_MESH2, ClockMesh
+from .design_rules import raise_first
 from .m739_data import M739
+from .mesh_design import (
+    CLOCK_DESIGN,
+    INVOLUTE_DESIGN,
+    check_clock_design,
+    check_involute_design,
+    clock_pair,
+    design_defaults,
+    involute_pair,
+)
 from .mesh_efficiency import (
     LEGACY_PI,
+    ClockMeshModel,
     InvoluteGeometry,
+    clock_table_breaks,
+    contact_efficiency,
     involute_efficiency_at,
     involute_geometry,
     involute_phase_breaks,
@@ -67,7 +87,13 @@ from .mesh_efficiency import (
     train_mesh_efficiency,
     train_mesh_window,
 )
-from .mesh_efficiency_data import ALFIN_ANOMALY_TABLES, INVOLUTE_MESHES, PRINTED_RUNS
+from .mesh_efficiency_data import (
+    ALFIN_ANOMALY_TABLES,
+    INVOLUTE_MESHES,
+    PRINTED_RUNS,
+    ClockMeshData,
+    InvoluteMesh,
+)
 
 MODEL_IDEAL, MODEL_INVOLUTE, MODEL_CLOCK = 0, 1, 2
 
@@ -75,6 +101,7 @@ MODEL_IDEAL, MODEL_INVOLUTE, MODEL_CLOCK = 0, 1, 2
 SINGLE_APPROACH, SINGLE_RECESS = 0, 1
 DUAL_APPROACH, DUAL_MIXED, DUAL_RECESS = 2, 3, 4
 ROR_APPROACH, ROR_RECESS, ROF_APPROACH, ROF_RECESS = 5, 6, 7, 8
+FOR_APPROACH, FOR_RECESS = 9, 10  # pinion round on the gear flank (Tables 1-4 meshes)
 REGIME_NAMES = {
     SINGLE_APPROACH: "single-approach",
     SINGLE_RECESS: "single-recess",
@@ -85,6 +112,8 @@ REGIME_NAMES = {
     ROR_RECESS: "round-on-round-recess",
     ROF_APPROACH: "round-on-flank-approach",
     ROF_RECESS: "round-on-flank-recess",
+    FOR_APPROACH: "flank-on-round-approach",
+    FOR_RECESS: "flank-on-round-recess",
 }
 
 #: Clock meshes of the M739-like train and (gear, pinion) pivot radii of the M739 input data:
@@ -175,27 +204,57 @@ class MeshModel:
 
 
 class InvoluteModel(MeshModel):
-    """Involute mesh of Tepper 1981 (Tables 5–13 as published, driver as run)."""
+    """Involute mesh of Tepper 1981: a stored one (Tables 5-13 as published, driver as run)
+    or a user pair (``InvoluteModel.of_pair``)."""
 
-    def __init__(self, k: int, mu: float, printed_run: bool, ideal: bool = False) -> None:
-        table = k + 4
-        mesh = INVOLUTE_MESHES[table]
-        alpha_fin = None
-        if printed_run and table in ALFIN_ANOMALY_TABLES:  # the 1981 program's ALFIN (Tables 15-21)
-            alpha_fin = PRINTED_RUNS[table].alfin_deg * LEGACY_PI / 180.0
+    def __init__(
+        self,
+        mesh: InvoluteMesh,
+        name: str,
+        mu: float,
+        printed_run: bool,
+        ideal: bool = False,
+        alpha_fin: float | None = None,
+        rasfact: float = 0.883,
+        points: int = 25,
+    ) -> None:
+        self.pair = mesh
         self.geometry: InvoluteGeometry = involute_geometry(
-            mesh, alpha_fin=alpha_fin, legacy=printed_run
+            mesh, alpha_fin=alpha_fin, legacy=printed_run, rasfact=rasfact
         )
         g = self.geometry
         self.mu = 0.0 if ideal else mu
         self.ideal = ideal
-        self.name = f"{'ideal ' if ideal else ''}involute mesh {k} (Table {table}, {mesh.name})"
+        self.points = points  # K of the report's cycle efficiency
+        self.name = f"{'ideal ' if ideal else ''}{name}"
         self.cycle, self.cycle_start = g.cycle_angle, g.alpha_in
         self._ratio = g.driver_base_radius / g.driven_base_radius
         self._tan_op = math.tan(g.op_pressure_angle)
         self.breaks = involute_phase_breaks(g)
         self.kinds = ("pair", "contact", "pitch")
         self._finish()
+
+    @classmethod
+    def stored(cls, k: int, mu: float, printed_run: bool, ideal: bool = False) -> InvoluteModel:
+        """Involute mesh k = Table k + 4; printed_run: the printed ALFIN of Tables 15-21."""
+        table = k + 4
+        mesh = INVOLUTE_MESHES[table]
+        alpha_fin = None
+        if printed_run and table in ALFIN_ANOMALY_TABLES:  # the 1981 program's ALFIN (Tables 15-21)
+            alpha_fin = PRINTED_RUNS[table].alfin_deg * LEGACY_PI / 180.0
+        name = f"involute mesh {k} (Table {table}, {mesh.name})"
+        return cls(mesh, name, mu, printed_run, ideal, alpha_fin)
+
+    @classmethod
+    def of_pair(
+        cls, design: Mapping[str, float], mu: float, printed_run: bool, ideal: bool = False
+    ) -> InvoluteModel:
+        """The user pair of the design parameters (the end of dual contact as the physics
+        gives it: a printed ALFIN belongs to a stored run, not to its inputs)."""
+        return cls(
+            involute_pair(design), "user involute pair", mu, printed_run, ideal,
+            rasfact=design["undercut_factor"], points=int(design["points_per_cycle"]),
+        )  # fmt: skip
 
     def _phase(self, theta: float) -> int:
         g = self.geometry
@@ -259,20 +318,86 @@ class ClockModel(MeshModel):
         return -c.pinion_angle, -c.ratio, eff
 
 
+class ClockTableModel(MeshModel):
+    """Clock mesh in the form of Tepper 1981, Tables 1-4 (mesh_efficiency.ClockMeshModel,
+    derived statics), the gear driving counter-clockwise."""
+
+    def __init__(self, mesh: ClockMeshData, center_distance: float, mu: float) -> None:
+        self.model = ClockMeshModel(mesh, center_distance)
+        self.mu = mu
+        self.rho_gear, self.rho_pinion = mesh.gear_pivot_radius, mesh.pinion_pivot_radius
+        self.name = f"{mesh.name} ({mesh.n_gear}:{mesh.n_pinion}, Tables 1-4 form)"
+        found = _clock_table_breaks(mesh, center_distance)
+        self.cycle_start, self.cycle = found[0][0], self.model.pitch_g
+        self.breaks = tuple(b for b, _, _, _ in found)
+        self.kinds = tuple(kind for _, kind, _, _ in found)
+        self._phases = {b: (phase, approach) for b, _, phase, approach in found}
+        self._finish()
+
+    def _phase(self, theta: float) -> int:
+        local = self.cycle_start + (theta - self.cycle_start) % self.cycle
+        opening = max(b for b in self.breaks if b <= local)
+        phase, approach = self._phases[opening]
+        a, r = {"ror": (ROR_APPROACH, ROR_RECESS), "rof": (ROF_APPROACH, ROF_RECESS),
+                "for": (FOR_APPROACH, FOR_RECESS)}[phase]  # fmt: skip
+        return a if approach else r
+
+    def evaluate(self, theta: float) -> tuple[float, float, float]:
+        c = self.model.contact(theta)
+        eff, ratio = contact_efficiency(
+            _ORIGIN, self.model.o_p, c.contact, c.normal, self.mu, self.rho_gear, self.rho_pinion
+        )
+        return -c.pinion_angle, -ratio, eff
+
+    def efficiency(self, theta: float) -> float:
+        return self.evaluate(theta)[2]
+
+    def ratio(self, theta: float) -> float:
+        return self.evaluate(theta)[1]
+
+    def driven(self, theta: float) -> float:
+        return -self.model.contact(theta).pinion_angle
+
+
+_ORIGIN = np.zeros(2)
+
+
 @cache
 def _clock_breaks(k: int) -> tuple[tuple[float, str], ...]:
     """Phase changes of clock mesh k, found once per process (root finding)."""
     return train_mesh_breaks(CLOCK_MESHES[k][0])
 
 
-def build_mesh(model: int, mesh: int, clock_mesh: int, mu: float, printed_run: int) -> MeshModel:
-    """The mesh model the parameters select; ComponentError naming the parameter if invalid."""
+@cache
+def _clock_table_breaks(mesh: ClockMeshData, center_distance: float):  # noqa: ANN202
+    """Phase changes of a Tables 1-4 clock mesh, found once per design (root finding)."""
+    return clock_table_breaks(ClockMeshModel(mesh, center_distance))
+
+
+def build_mesh(
+    model: int,
+    mesh: int,
+    clock_mesh: int,
+    mu: float,
+    printed_run: int,
+    design: Mapping[str, float] | None = None,
+) -> MeshModel:
+    """The mesh model the parameters select; ComponentError naming the parameter if invalid.
+
+    design: the design parameters (mesh_design; missing ones take their defaults), read when
+    ``mesh = 0`` or ``clock_mesh = 0`` selects the user pair, whose consistency rules are
+    checked first (DesignError on the first broken one).
+    """
 
     def choice(name: str, value: float, allowed: range) -> int:
         if value != int(value) or int(value) not in allowed:
             raise ComponentError(
                 f"GearMesh: {name} must be one of {list(allowed)}, got {value!r}"
-                + (" (involute mesh k is Table k + 4 of Tepper 1981)" if name == "mesh" else "")
+                + (
+                    " (involute mesh k is Table k + 4 of Tepper 1981, 0 the user pair)"
+                    if name == "mesh"
+                    else ""
+                )
             )
         return int(value)
 
@@ -280,10 +405,23 @@ def build_mesh(model: int, mesh: int, clock_mesh: int, mu: float, printed_run: i
     if not (math.isfinite(mu) and mu >= 0.0):
         raise ComponentError(f"GearMesh: mu must be >= 0, got {mu!r}")
     if m == MODEL_CLOCK:
-        return ClockModel(choice("clock_mesh", clock_mesh, range(1, 3)), mu)
-    k = choice("mesh", mesh, range(1, 10))
+        c = choice("clock_mesh", clock_mesh, range(3))
+        if c > 0:
+            return ClockModel(c, mu)
+        p = design_defaults() | dict(design or {})
+        raise_first(check_clock_design(clock_pair(p), p["clock_center_distance"]))
+        return ClockTableModel(clock_pair(p), p["clock_center_distance"], mu)
+    k = choice("mesh", mesh, range(10))
     legacy = choice("printed_run", printed_run, range(2)) == 1
-    return InvoluteModel(k, mu, legacy, ideal=m == MODEL_IDEAL)
+    if k > 0:
+        return InvoluteModel.stored(k, mu, legacy, ideal=m == MODEL_IDEAL)
+    p = design_defaults() | dict(design or {})
+    for name in ("n_pinion", "points_per_cycle", "gear_drives"):
+        if p[name] != int(p[name]):
+            raise ComponentError(f"GearMesh: {name} must be a whole number, got {p[name]!r}")
+    choice("gear_drives", p["gear_drives"], range(2))
+    raise_first(check_involute_design(involute_pair(p), p["undercut_factor"]))
+    return InvoluteModel.of_pair(p, mu, legacy, ideal=m == MODEL_IDEAL)
 
 
 # ------------------------------------------------------------------------------------------
@@ -310,13 +448,15 @@ class GearMesh(Component):
         ),
         Variable(
             "mesh", "parameter", "1", 2,
-            "involute mesh k = 1..9: Table k + 4 of Tepper 1981 (2: the Appendix E mesh)",
-            "Integer", min=1, max=9,
+            "involute mesh k = 1..9: Table k + 4 of Tepper 1981 (2: the Appendix E mesh); "
+            "0: the user pair of the design parameters",
+            "Integer", min=0, max=9,
         ),
         Variable(
             "clock_mesh", "parameter", "1", 1,
-            "clock mesh 1 or 2 of the M739-like two-pass train (M739_MESH1 / M739_MESH2)",
-            "Integer", min=1, max=2,
+            "clock mesh 1 or 2 of the M739-like two-pass train (M739_MESH1 / M739_MESH2); "
+            "0: the user clock mesh (Tables 1-4 form) of the design parameters",
+            "Integer", min=0, max=2,
         ),
         Variable(
             "printed_run", "parameter", "1", 0,
@@ -332,6 +472,8 @@ class GearMesh(Component):
             "start within the mesh cycle, as a fraction of it (0: a new pair enters)",
             min=0.0, max=1.0,
         ),
+        *INVOLUTE_DESIGN,
+        *CLOCK_DESIGN,
         Variable(
             "load_torque", "input", "N.m", 0.1,
             "torque resisting the driven member's motion (>= 0)",
@@ -367,8 +509,9 @@ class GearMesh(Component):
 
     # -- life cycle -------------------------------------------------------------------
     def initialize(self, t0: float) -> None:
+        design = {v.name: getattr(self, v.name) for v in INVOLUTE_DESIGN + CLOCK_DESIGN}
         self._cache_model = build_mesh(
-            self.model, self.mesh, self.clock_mesh, self.mu, self.printed_run
+            self.model, self.mesh, self.clock_mesh, self.mu, self.printed_run, design
         )
         m = self._cache_model
         if not (math.isfinite(self.speed) and self.speed > 0.0):

@@ -643,3 +643,102 @@ def train_mesh_cycle_summary(
         raise ValueError(f"point efficiency reaches zero with mu = {mu}: the mesh locks")
     turned = 2.0 * math.pi / mesh.n_pinion  # one leaf per gear pitch
     return CycleSummary(turned / inv_eff, mean / pitch, min(values), max(values), turned / pitch)
+
+
+# ------------------------------------------------------------------------------------------
+# Contact phases and a cycle at constant load of a Tables 1-4 clock mesh (ClockMeshModel)
+# ------------------------------------------------------------------------------------------
+def _clock_table_sliding(model: ClockMeshModel, phi: float) -> float:
+    """Sliding speed of the gear over the pinion along the common tangent, per unit gear speed
+    (zero at the pitch point, where the contact crosses the line of centres)."""
+    c = model.contact(phi)
+    r1, r2 = c.contact, c.contact - model.o_p
+    ratio = _cross(r1, c.normal) / _cross(r2, c.normal)
+    v = np.array([-r1[1], r1[0]]) - ratio * np.array([-r2[1], r2[0]])
+    return _cross(c.normal, v)
+
+
+def clock_table_breaks(model: ClockMeshModel) -> tuple[tuple[float, str, str, bool], ...]:
+    """Gear angles [rad] of one gear pitch where the contact of a Tables 1-4 clock mesh changes:
+    (angle, kind, phase of the piece it opens, approach), sorted, the first being where a new
+    pair takes over ("pair"); "contact": round-on-round / round-on-flank / flank-on-round
+    changes; "pitch": the sliding reverses at the line of centres.  Approach: the contact lies
+    before the line of centres (the gear turns counter-clockwise, the pinion pivot on +x)."""
+    pitch = model.pitch_g
+
+    def tag(phi: float) -> tuple[int, str]:
+        c = model.contact(phi)
+        if c is None:
+            raise ValueError(f"no pair in contact at gear angle {phi!r} rad")
+        return c.pair, c.phase
+
+    def boundary(lo: float, hi: float) -> float:
+        t_lo = tag(lo)
+        for _ in range(80):
+            mid = 0.5 * (lo + hi)
+            if mid in (lo, hi):
+                break
+            lo, hi = (mid, hi) if tag(mid) == t_lo else (lo, mid)
+        return hi
+
+    n = 128
+    grid = [pitch * (k / n - 0.5) for k in range(n + 1)]
+    tags = [tag(x) for x in grid]
+    changes = []
+    for k in range(n):
+        if tags[k] != tags[k + 1]:
+            kind = "pair" if tags[k][0] != tags[k + 1][0] else "contact"
+            changes.append((boundary(grid[k], grid[k + 1]), kind))
+    starts = [x for x, kind in changes if kind == "pair"]
+    if len(starts) != 1:
+        raise ValueError(f"expected one change of tooth pair per gear pitch, found {len(starts)}")
+    start = starts[0]
+    found = [(start + (x - start) % pitch, kind) for x, kind in changes]
+    ends = [x for x, _ in sorted(found)] + [start + pitch]
+    for a, b in zip(ends[:-1], ends[1:], strict=True):
+        eps = 1e-9 * pitch
+        xs = np.linspace(a + eps, b - eps, 33)
+        values = [_clock_table_sliding(model, float(x)) for x in xs]
+        for k in range(32):
+            if values[k] * values[k + 1] < 0.0:
+                root = brentq(
+                    lambda x: _clock_table_sliding(model, x), float(xs[k]), float(xs[k + 1]),
+                    xtol=1e-15, rtol=1e-15,
+                )  # fmt: skip
+                found.append((root, "pitch"))
+    found.sort()
+    ends = [x for x, _ in found] + [start + pitch]
+    out = []
+    for (x, kind), b in zip(found, ends[1:], strict=True):
+        c = model.contact(0.5 * (x + b))
+        out.append((x, kind, c.phase, bool(c.contact[1] < 0.0)))
+    return tuple(out)
+
+
+def clock_table_cycle_summary(model: ClockMeshModel, mu: float) -> CycleSummary:
+    """CycleSummary of a Tables 1-4 clock mesh over one gear pitch from a new pair's takeover
+    (adaptive quadrature per contact phase; extremes 1e-9 of the pitch inside each)."""
+    from scipy.integrate import quad
+
+    breaks = [b[0] for b in clock_table_breaks(model)]
+    pitch = model.pitch_g
+    ends = [*breaks, breaks[0] + pitch]
+    m = model.mesh
+    rho_g, rho_p = m.gear_pivot_radius, m.pinion_pivot_radius
+
+    def point(x: float) -> tuple[float, float]:
+        c = model.contact(x)
+        return contact_efficiency(np.zeros(2), model.o_p, c.contact, c.normal, mu, rho_g, rho_p)
+
+    inv_eff = mean = 0.0
+    values = []
+    kw = {"epsabs": 0.0, "epsrel": 1e-13, "limit": 200}
+    for a, b in zip(ends[:-1], ends[1:], strict=True):
+        inv_eff += quad(lambda x: -point(x)[1] / point(x)[0], a, b, **kw)[0]
+        mean += quad(lambda x: point(x)[0], a, b, **kw)[0]
+        eps = 1e-9 * pitch
+        values += [point(float(x))[0] for x in np.linspace(a + eps, b - eps, 201)]
+    if min(values) <= 0.0:
+        raise ValueError(f"point efficiency reaches zero with mu = {mu}: the mesh locks")
+    return CycleSummary(model.pitch_p / inv_eff, mean / pitch, min(values), max(values),
+                        model.pitch_p / pitch)  # fmt: skip

@@ -21,4 +21,5 @@ FAMILY = SceneFamily(
     analysis="orchestrator.scenes.gear_mesh.report:analyse",
     plot="orchestrator.scenes.gear_mesh.report:plot",
     reference="orchestrator.scenes.gear_mesh.report:reference",
+    drawing="orchestrator.scenes.gear_mesh.drawing:draw",
 )

@@ -36,16 +36,20 @@ from typing import Any
 import numpy as np
 
 from components.base import ComponentError
+from components.design_rules import Violation
 from components.gear_mesh import (
     REGIME_NAMES,
     ClockModel,
+    ClockTableModel,
     GearMesh,
     InvoluteModel,
     MeshModel,
     build_mesh,
 )
+from components.mesh_design import check_mesh_design
 from components.mesh_efficiency import (
     CycleSummary,
+    clock_table_cycle_summary,
     involute_cycle,
     involute_cycle_summary,
     involute_efficiency_curve,
@@ -87,7 +91,7 @@ class MeshScene:
 
     @property
     def family(self) -> str:
-        return "clock" if isinstance(self.model, ClockModel) else "involute"
+        return "involute" if isinstance(self.model, InvoluteModel) else "clock"
 
     def angle(self, t: np.ndarray | float) -> np.ndarray | float:
         """Driver angle at scene time t, computed as the component does."""
@@ -105,7 +109,7 @@ def mesh_scene(scene: Scene) -> MeshScene:
     try:
         model = build_mesh(
             params["model"], params["mesh"], params["clock_mesh"], params["mu"],
-            params["printed_run"],
+            params["printed_run"], params,
         )  # fmt: skip
     except ComponentError as exc:
         raise ScenarioError(scene.path, f"fmus.{inst}.parameters", str(exc)) from None
@@ -117,6 +121,18 @@ def mesh_scene(scene: Scene) -> MeshScene:
     connected = any(c.target == (inst, "load_torque") for c in scene.connections)
     theta0 = model.cycle_start + params["phase0"] * model.cycle
     return MeshScene(inst, params, float(load), connected, model, scene.start, theta0)
+
+
+def check(scene: Scene) -> list[Violation]:
+    """Every broken consistency rule of the user pair the scene's GearMesh selects (empty for
+    a stored mesh): components.mesh_design.check_mesh_design on its parameters."""
+    names = [n for n, spec in scene.fmus.items() if spec.component == "GearMesh"]
+    out: list[Violation] = []
+    for name in names:
+        params = {v.name: float(v.start) for v in GearMesh.variables("parameter")}
+        params.update(scene.fmus[name].parameters)
+        out.extend(check_mesh_design(params))
+    return out
 
 
 def _whole_cycles(ms: MeshScene, theta_first: float, theta_last: float) -> tuple[float, int]:
@@ -206,6 +222,8 @@ def cycle_summary(ms: MeshScene) -> CycleSummary:
     m = ms.model
     if isinstance(m, InvoluteModel):
         return involute_cycle_summary(m.geometry, m.mu)
+    if isinstance(m, ClockTableModel):
+        return clock_table_cycle_summary(m.model, m.mu)
     assert isinstance(m, ClockModel)
     return train_mesh_cycle_summary(m.mesh, m.mu, m.rho_gear, m.rho_pinion)
 
@@ -321,9 +339,13 @@ def plot(scene: Scene, header: list[str], data: np.ndarray, path: Path) -> None:
                 style = {"pair": ":", "contact": "--", "pitch": "-."}[kind]
                 ax.axvline(np.degrees(x), color="0.8", ls=style, lw=0.8)
     if isinstance(m, InvoluteModel) and not m.ideal:
-        alphas, pts, cyc, mn = involute_cycle(m.geometry, m.mu)
+        alphas, pts, cyc, mn = involute_cycle(m.geometry, m.mu, m.points)
         ax.plot(
-            np.degrees(alphas), pts, "x", color="C3", label=f"report K = 25 (CYCLEFF {cyc:.4f})"
+            np.degrees(alphas),
+            pts,
+            "x",
+            color="C3",
+            label=f"report K = {m.points} (CYCLEFF {cyc:.4f})",
         )
     ax.plot(deg, col[f"{p}.efficiency"], ".-", color="C0", ms=2, lw=0.8, label="co-simulation")
     ax.set_ylabel("point efficiency")
