@@ -22,4 +22,5 @@ FAMILY = SceneFamily(
     plot="orchestrator.scenes.gear_mesh.report:plot",
     reference="orchestrator.scenes.gear_mesh.report:reference",
     drawing="orchestrator.scenes.gear_mesh.drawing:draw",
+    design_check="orchestrator.scenes.gear_mesh.report:check",
 )
