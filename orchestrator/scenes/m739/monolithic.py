@@ -9,8 +9,10 @@ friction reversals, arming angle).  No equation is repeated here.
 ``run_m739`` returns turns to arm, arming time, force maxima (the report's F23MAX, F12MAX
 in coupled motion, FF23MAX, FF12MAX in free motion, PNMAX), number of impacts, a regime
 log [(t, from, to)] (codes of ``components.verge_escapement``: 0 free, 1 coupled on the
-entrance face, 2 coupled on the exit face), every event with its cause, and time series
-sampled every ``sample_dt`` (t, phi, phi_dot, psi, psi_dot, regime, f12, f23, pn; SI).
+entrance face, 2 coupled on the exit face), every event with its cause, a log of the
+train's direction of motion [(t, from, to)] (the ``components.gear_train`` regime codes: 0
+stuck, 1 forward, 2 backward) and time series sampled every ``sample_dt`` (t, phi, phi_dot,
+psi, psi_dot, regime, f12, f23, pn; SI).
 It never raises: a run that cannot arm ends with ``armed = False`` and a reason (stall,
 self-locking, verge disengaged, stop time reached, numerical failure).
 """
@@ -24,12 +26,28 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from components.event_integration import IntegrationStepControl, advance
-from components.gear_train import INDEXING_AS_RUN, INDEXING_PHYSICAL, TrainPhysics
+from components.gear_train import (
+    INDEXING_AS_RUN,
+    INDEXING_PHYSICAL,
+    TRAIN_BACKWARD,
+    TRAIN_FORWARD,
+    TRAIN_STUCK,
+    TrainPhysics,
+)
 from components.m739_data import LBF, M739, M739Data, rpm_to_rad_s
-from components.verge_escapement import STATE_SCALES, VergeConstants, VergeCore
+from components.verge_escapement import (
+    IND_CONTACT,
+    IND_FACE_END,
+    STATE_SCALES,
+    VergeConstants,
+    VergeCore,
+)
 
 #: Relative local error tolerance of the monolithic integration: turns to arm move by less
-#: than 1e-7 relative when it is tightened tenfold (tests/components/test_m739_physics.py).
+#: than 1e-7 relative when it is tightened tenfold (tests/components/test_m739_physics.py; with
+#: restitution 0.3 and 0.6 too, tests/scenes/test_m739_restitution.py).  Not so at e_rest = 1:
+#: elastic impacts make the motion chaotic (a 1e-11 s difference in the event times at 20 ms
+#: grows to 1e-4 s at 90 ms) and turns to arm move by 8.7e-4 from 1e-9 to 1e-10.
 REFERENCE_TOLERANCE = 1.0e-9
 #: The integration runs in stretches of this length (a stall or fault ends at the next).
 OUTPUT_CHUNK = 1.0e-3
@@ -54,6 +72,7 @@ class M739Result:
     t_end: float
     phi_end: float
     series: dict[str, np.ndarray] = field(default_factory=dict)
+    train_log: list[tuple[float, int, int]] = field(default_factory=list)
 
     def summary(self) -> str:
         """One line, forces in lb (the report's unit)."""
@@ -71,6 +90,41 @@ class VergeTrainMonolithic(VergeCore):
     def __init__(self, *args: object, **kwargs: object) -> None:
         super().__init__(*args, **kwargs)  # type: ignore[arg-type]
         self.f23_max = self.f12_max = self.ff23_max = self.ff12_max = self.pn_max = 0.0
+        # (face, phi_off, shift): the contact indicator of that face is raised by shift [m]
+        # (see arm_contact); None: not raised.
+        self.gap_shift: tuple[int, float, float] | None = None
+        self.train_log: list[tuple[float, int, int]] = []
+
+    def train_code(self) -> int:
+        """The train's direction of motion as a regime code of ``components.gear_train``."""
+        if self.train_stuck:
+            return TRAIN_STUCK
+        return TRAIN_FORWARD if self.train.direction > 0 else TRAIN_BACKWARD
+
+    def indicators(self, y: list[float]) -> tuple[float, ...]:
+        ind = super().indicators(y)
+        shift = self.gap_shift
+        if shift is None or self.coupled or shift[:2] != (self.face, self.phi_off):
+            return ind
+        return (*ind[:IND_CONTACT], ind[IND_CONTACT] + shift[2], *ind[IND_CONTACT + 1 :])
+
+    def arm_contact(self, y: list[float]) -> None:
+        """Arm the face's contact indicator after the tooth left it in free motion.
+
+        A contact is located just past the face plane (sigma f < 0 by the location
+        tolerance, about 1e-13 m), and a rebound (e > 0) or a separation leaves the tooth
+        there.  An indicator that starts a step below zero is not armed, so a return to the
+        face within the same step went unseen: at e = 0.3 one step ran 57 us from an exit
+        rebound past the face end while the tooth struck the face again, and the reference
+        lost that impact and every later one.  Raising the indicator by twice the
+        penetration arms it; the next contact is then located 1e-13 m behind the plane.
+        """
+        self.gap_shift = None
+        if self.coupled:
+            return
+        raw = super().indicators(y)[IND_CONTACT]
+        if raw < 0.0:
+            self.gap_shift = (self.face, self.phi_off, -2.0 * raw)
 
     def record(self, y: list[float]) -> None:
         """Forces at an accepted point (OUTP / OUTPF of the report)."""
@@ -96,7 +150,13 @@ class VergeTrainMonolithic(VergeCore):
         self.record(y)
 
     def event(self, y: list[float], index: int, t: float) -> list[float]:
+        before = self.train_code()
         y = super().event(y, index, t)
+        after = self.train_code()
+        if after != before:  # impact recoil, wheel reversal or stall
+            self.train_log.append((self.t_base + t, before, after))
+        if index in (IND_FACE_END, IND_CONTACT):  # the tooth may now leave a face plane
+            self.arm_contact(y)
         if self.train_stuck:
             self.halted = True
         elif not self.halted:
@@ -125,10 +185,12 @@ def run_m739(
     tolerance: float = REFERENCE_TOLERANCE,
     sample_dt: float = 1.0e-5,
     data: M739Data = M739,
+    h_max: float = math.inf,
 ) -> M739Result:
     """Simulate the M739 from rest on the entrance face until arming or t_stop.
 
     Arming is phi_T = PHICUTD (1485 deg of escape wheel); turns = spin [rev/s] * t_arm.
+    ``h_max`` [s] caps the integration step (none by default: every event is located).
     """
     omega = rpm_to_rad_s(rpm)
     events: list[tuple[float, int, int, str]] = []
@@ -140,7 +202,7 @@ def run_m739(
     train = TrainPhysics(data, mu=mu, omega=omega, indexing=code)
     k = VergeConstants(data, mu1, mu, omega, e_rest)
     core = VergeTrainMonolithic(k, train, data.phi_start, phi_stop=data.phi_cut, log=log)
-    return simulate(core, data, events, t_stop, tolerance, sample_dt)
+    return simulate(core, data, events, t_stop, tolerance, sample_dt, h_max=h_max)
 
 
 def simulate(
@@ -151,6 +213,7 @@ def simulate(
     tolerance: float,
     sample_dt: float,
     max_events: int = 100_000,
+    h_max: float = math.inf,
 ) -> M739Result:
     """Run a monolithic verge-and-train model from rest until it halts or t_stop; never raises.
 
@@ -184,7 +247,7 @@ def simulate(
         cols["f23"].append(f23)
         cols["pn"].append(pn)
 
-    control = IntegrationStepControl(tolerance, STATE_SCALES)
+    control = IntegrationStepControl(tolerance, STATE_SCALES, h_max)
     h_next = 0.0
     t = 0.0
     sample(t, y)
@@ -249,4 +312,5 @@ def _finish(
         t_end=t,
         phi_end=y[0],
         series={n: np.asarray(v) for n, v in cols.items()},
+        train_log=list(core.train_log),
     )
