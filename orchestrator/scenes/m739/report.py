@@ -16,6 +16,7 @@ from typing import Any
 
 import numpy as np
 
+from components.gear_train import TRAIN_REGIME_NAMES
 from components.m739_data import LBF, M739
 from components.units import RPM_PER_RAD_S
 from components.verge_escapement import FREE, REGIME_NAMES
@@ -179,6 +180,13 @@ def reference_from(result: Any, train: str, verge: str) -> Reference:
         (te, verge, REGIME_NAMES.get(a, str(a)), REGIME_NAMES.get(b, str(b)))
         for te, a, b in result.regime_log
     ]
+    # The train's reversals and sticks, as the train FMU logs them (an impact with rebound
+    # throws the wheel back).
+    events += [
+        (te, train, TRAIN_REGIME_NAMES.get(a, str(a)), TRAIN_REGIME_NAMES.get(b, str(b)))
+        for te, a, b in getattr(result, "train_log", ())
+    ]
+    events.sort(key=lambda e: e[0])
     return Reference(headline=headline, signals=signals, events=events, t_range=t_range)
 
 
