@@ -184,6 +184,14 @@ def recorded(ax: Any, t: np.ndarray, y: np.ndarray, *, steps: bool = False, **st
     return line
 
 
+def column_unit(scene: Any, column: str) -> str:
+    """The unit an FMU declares for a recorded column ``instance.variable`` ("1": none)."""
+    instance, _, name = column.partition(".")
+    model = getattr(scene.fmus.get(instance), "model", None)
+    variable = getattr(model, "variables", {}).get(name)
+    return getattr(variable, "unit", None) or "1"
+
+
 def unit_label(ax: Any, quantity: str, unit: str, colour: str | None = None) -> None:
     """Label an axis with its quantity and unit."""
     ax.set_ylabel(f"{quantity} [{unit}]", **({"color": colour} if colour else {}))
