@@ -116,3 +116,89 @@ def test_report_of_a_run_that_never_started(tmp_path: Path, capsys) -> None:
         "  no steps taken",
         f"  results in {tmp_path}",
     ]
+
+
+# -- run plots ---------------------------------------------------------------------------------
+SCENARIOS = TWO.parent
+#: one short run of each example family (plots only: no reference)
+#: (the M739's is made by test_the_m739_plot_names_the_fmus_regimes; the clock train's, the
+#: same figure with two panels more, takes some 10 s to load, run and draw: slow)
+SHORT_RUNS = {
+    "clock_train": ("clock_train_sa.toml", "1 ms"),
+    "press_feed": ("press_feed_run1.toml", "0.05 s"),
+    "detached_lever": ("lever_unit_decay.toml", "1 s"),
+    "gear_mesh": ("mesh_efficiency.toml", "0.02 s"),
+}
+
+
+@pytest.mark.parametrize(
+    "family",
+    [pytest.param(f, marks=pytest.mark.slow) if f == "clock_train" else f for f in SHORT_RUNS],
+)
+def test_every_family_plots_a_short_run(family: str, tmp_path: Path) -> None:
+    from orchestrator.run import run_scene
+    from orchestrator.scenario import load_scene
+
+    file, stop = SHORT_RUNS[family]
+    scene = load_scene(SCENARIOS / file, {"scene.stop": stop})
+    assert scene.family == family
+    result = run_scene(scene, tmp_path, show_progress=False, compare_reference=False)
+    assert result.status == "completed", result.message
+    assert not [n for n in result.notes if n.startswith("plot")], result.notes
+    assert (tmp_path / f"{scene.name}.png").stat().st_size > 10_000
+
+
+def test_two_inertias_plot(tmp_path: Path) -> None:
+    from orchestrator.run import run_scene
+    from orchestrator.scenario import load_scene
+    from orchestrator.scenes import PLOTS
+
+    scene = load_scene(TWO, {"scene.stop": "5 ms"})
+    result = run_scene(scene, tmp_path, show_progress=False, compare_reference=False)
+    PLOTS["two_inertias"](scene, result.header, result.data, tmp_path / "two.png")
+    assert (tmp_path / "two.png").stat().st_size > 10_000
+
+
+def test_regime_spans_start_and_end_at_the_located_switches() -> None:
+    from orchestrator.plotting import regime_spans
+
+    names = {0: "free", 1: "coupled-entrance", 2: "coupled-exit"}
+    t = [0.0, 1.0, 2.0, 3.0, 4.0]
+    recorded = [1, 1, 0, 2, 2]
+    events = [(1.25, "verge", "coupled-entrance", "free"), (2.5, "verge", "free", "coupled-exit")]
+    assert regime_spans(t, recorded, names, events) == [
+        (0.0, 1.25, "coupled-entrance"),
+        (1.25, 2.5, "free"),
+        (2.5, 4.0, "coupled-exit"),
+    ]
+    # without events: from the row that first records a regime to the next that records another
+    assert regime_spans(t, recorded, names) == [
+        (0.0, 2.0, "coupled-entrance"),
+        (2.0, 3.0, "free"),
+        (3.0, 4.0, "coupled-exit"),
+    ]
+
+
+def test_the_m739_plot_names_the_fmus_regimes(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The detail's bands are labelled with the regime names the FMUs declare in their model
+    descriptions (the verge's and the train's regime Enumeration)."""
+    from orchestrator.run import run_scene
+    from orchestrator.scenario import load_scene
+    from orchestrator.scenes.m739 import report
+
+    figures = []
+    monkeypatch.setattr(report, "save_figure", lambda fig, path, title=None: figures.append(fig))
+    scene = load_scene(SCENARIOS / "m739.toml", {"scene.stop": "3 ms"})
+    run_scene(scene, tmp_path, show_progress=False, compare_reference=False)
+    (fig,) = figures
+    legends = [ax.get_legend() for ax in fig.axes if ax.get_legend() is not None]
+    labels = {text.get_text() for legend in legends for text in legend.get_texts()}
+    declared = {
+        name
+        for instance in ("verge", "train")
+        for name in scene.fmus[instance].model.regime_names.values()
+    }
+    met = {"free", "coupled-entrance", "coupled-exit", "forward"}  # in the first 3 ms
+    assert met <= declared and met <= labels
