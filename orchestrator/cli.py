@@ -11,6 +11,7 @@ from pathlib import Path
 
 from orchestrator.errors import RunError, ScenarioError
 from orchestrator.interrupt import Interrupted, report_interrupted, signum_of
+from orchestrator.run_text import summary_lines
 
 
 class _OneLineErrors(argparse.ArgumentParser):
@@ -190,8 +191,12 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("name", choices=["overhead", "m739", "speed", "supervision"])
     p.set_defaults(handler=_bench)
 
-    p = sub.add_parser("report", help="print the summary of a finished run")
-    p.add_argument("run_dir", type=Path)
+    p = sub.add_parser(
+        "report",
+        help="print what a run printed as it ended (completed, failed, interrupted or crashed)",
+    )
+    p.add_argument("run_dir", type=Path, help="the run's results directory (its summary.json)")
+    p.add_argument("--json", action="store_true", help="the summary as JSON instead")
     p.set_defaults(handler=_report)
 
     args = parser.parse_args(argv)
@@ -285,36 +290,18 @@ def _run_guarded(args: argparse.Namespace) -> int:
     check_cache_dir()
     scene = _load(args.scene, _overrides(args.set), args.force)
     result = run_scene(scene, output_dir=args.output, show_progress=not args.no_progress)
-    message = _one_line(RuntimeError(result.message)) if result.message else ""
-    if message != result.message.strip():
-        message += " (full message in summary.json)"
-    print(f"scene {scene.name}: {result.status}" + (f" — {message}" if message else ""))
-    for name, q in result.headline.items():
-        print(headline_line(name, q))
-    for name, value in result.accuracy.items():
-        print(f"  {name:32s} {value:.4g}")
-    for note in result.notes:  # what the analyses could not compute
-        print(f"  note: {note}")
-    for warning in result.stats.extra.get("warnings", []):  # what the master gave up
-        print(f"  warning: {warning}")
-    if result.status == "interrupted" and result.interrupted_by is not None:
-        print(f"  interrupted at t = {result.time_reached:.9g} s (simulated)")
-    s = result.stats
-    print(
-        f"  steps {s.steps}, doSteps {s.do_steps}, rejections {s.rejections}, "
-        f"rollbacks {s.rollbacks}, events {s.events}, wall time {s.wall_time:.3f} s"
-    )
-    print(f"  results in {result.output_dir}")
+    summary = {
+        "scene": scene.name,
+        "status": result.status,
+        "message": result.message,
+        "time_reached": result.time_reached,
+        "headline": result.headline,
+        "accuracy": result.accuracy,
+        "notes": result.notes,
+        "stats": result.stats.as_dict(),
+    }
+    print("\n".join(summary_lines(summary, result.output_dir)))
     return 0 if result.status == "completed" else 1
-
-
-def headline_line(name: str, quantity: dict) -> str:
-    """One headline quantity as the run prints it; a dimensionless one (a count, a ratio)
-    without a unit."""
-    value = quantity["value"]
-    text = value if isinstance(value, str) else f"{value:.10g}"
-    unit = "" if quantity["unit"] in ("1", "") else f" {quantity['unit']}"
-    return f"  {name:32s} {text}{unit}"
 
 
 def _load(path: Path, overrides: dict, force: bool):  # noqa: ANN202 - a Scene
@@ -549,8 +536,10 @@ def _report(args: argparse.Namespace) -> int:
     if not isinstance(summary, dict) or not isinstance(summary.get("status"), str):
         print(f"error: {summary_file} is not a run summary (no status)", file=sys.stderr)
         return 2
-    keys = ("scene", "status", "message", "time_reached", "crash", "headline", "notes", "stats")
-    print(json.dumps({k: summary[k] for k in keys if k in summary}, indent=2))
+    if args.json:
+        print(json.dumps(summary, indent=2))
+    else:
+        print("\n".join(summary_lines(summary, args.run_dir)))
     return 0
 
 

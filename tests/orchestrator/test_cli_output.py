@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from orchestrator.cli import headline_line
+from orchestrator.run_text import headline_line
 
 
 def test_a_count_prints_without_a_unit_and_a_quantity_with_its_own() -> None:

@@ -308,4 +308,9 @@ def test_report_of_an_interrupted_run(tmp_path: Path, capsys) -> None:
         json.dumps({"scene": "s", "status": "interrupted", "time_reached": 0.1})
     )
     assert main(["report", str(tmp_path)]) == 0
+    assert capsys.readouterr().out.splitlines()[:2] == [
+        "scene s: interrupted",
+        "  interrupted at t = 0.1 s (simulated)",
+    ]
+    assert main(["report", str(tmp_path), "--json"]) == 0
     assert '"time_reached": 0.1' in capsys.readouterr().out

@@ -28,6 +28,7 @@ import numpy as np
 from components.verge_escapement import (
     FREE,
 )
+from orchestrator.plotting import recorded
 from orchestrator.scenario import Scene
 from orchestrator.scenes.clock_train.monolithic import ARMING_ROTOR_ANGLE, run_clock_train
 from orchestrator.scenes.family import Quantity, Reference, quantity
@@ -36,12 +37,11 @@ from orchestrator.scenes.m739.report import (
     _why_not_armed,
     crossing_time,
     escapement_arguments,
-    escapement_figure,
+    escapement_plot,
     force_max,
     instance_names,
     pn_max,
     reference_from,
-    save_figure,
     turns_to_arm,
 )
 
@@ -107,19 +107,26 @@ def reference(scene: Scene) -> Reference:
 
 
 def plot(scene: Scene, header: list[str], data: np.ndarray, path: Path) -> None:
-    """Verge and escape-wheel motion over the first cycles, with the train's speed ratio and
-    mesh efficiencies."""
+    """The whole run to arming above the first teeth in detail, the clock train's speed ratio
+    and mesh efficiencies among them."""
     train, _ = instance_names(scene)
-    fig, axes, (ms, col) = escapement_figure(scene, header, data, extra_panels=1)
-    if f"{train}.speed_ratio" in col:
-        axes[3].plot(ms, col[f"{train}.speed_ratio"], label="speed ratio (wheel/rotor)")
-        axes[3].set_ylabel("speed ratio [1]")
-        if f"{train}.efficiency1" in col:
-            ax3 = axes[3].twinx()
-            for i, c in ((1, "C2"), (2, "C3")):
-                ax3.plot(ms, col[f"{train}.efficiency{i}"], color=c, label=f"mesh {i} efficiency")
-            ax3.set_ylabel("point efficiency [1]")
-            ax3.legend(loc="lower right")
-        axes[3].legend(loc="upper right")
-    title = f"{scene.name}: verge, escape wheel and clock train, first cycles"
-    save_figure(fig, title, path)
+
+    def clock_panels(axes: list, ms: np.ndarray, col: dict[str, np.ndarray]) -> None:
+        if f"{train}.speed_ratio" in col:
+            recorded(axes[0], ms, col[f"{train}.speed_ratio"], color="C4")
+        axes[0].set_ylabel("speed ratio\nwheel/rotor [1]")
+        for i, c in ((1, "C5"), (2, "C6")):
+            if f"{train}.efficiency{i}" in col:
+                recorded(axes[1], ms, col[f"{train}.efficiency{i}"], color=c, label=f"mesh {i}")
+        axes[1].set_ylabel("point efficiency [1]")
+        if axes[1].get_lines():
+            axes[1].legend(loc="upper left", bbox_to_anchor=(1.005, 1.0), fontsize=8, frameon=False)
+
+    clock_panels.panels = 2  # type: ignore[attr-defined]
+    title = f"{scene.name}: M739 verge behind a clock gear train"
+    signal, level, rising = _arming(scene, train)
+    t = data[:, 0]
+    t_arm = (
+        crossing_time(t, data[:, header.index(signal)], level, rising) if signal in header else None
+    )
+    escapement_plot(scene, header, data, path, title, t_arm, extra=clock_panels)

@@ -43,6 +43,19 @@ from components.detached_lever import (
 )
 from components.detached_lever_data import TABLE_I
 from orchestrator.errors import ScenarioError
+from orchestrator.plotting import (
+    event_lines,
+    of,
+    recorded,
+    regime_bands,
+    regime_colours,
+    regime_names,
+    regime_spans,
+    run_events,
+    save_figure,
+    unit_label,
+    window,
+)
 from orchestrator.scenario import Scene
 from orchestrator.scenes.detached_lever.lever import LeverScene, lever_scene
 from orchestrator.scenes.detached_lever.monolithic import beat_run
@@ -273,7 +286,7 @@ def plot(scene: Scene, header: list[str], data: np.ndarray, path: Path) -> None:
     col = _columns(header, data, lever.instance)
     t = col["time"]
     n, times, amps = cycle_amplitudes(lever, col)
-    fig, axes = plt.subplots(2, 1, figsize=(10, 8))
+    fig, axes = plt.subplots(3, 1, figsize=(10, 11), height_ratios=(1, 1, 0.9))
     ax = axes[0]
     ax.plot(t, col["theta"], lw=0.6, color="C0", label="balance angle")
     envelope = col["amplitude"]
@@ -318,6 +331,28 @@ def plot(scene: Scene, header: list[str], data: np.ndarray, path: Path) -> None:
     ax.set_xlabel("cycle")
     ax.set_ylabel("amplitude [rad]")
     ax.legend(loc="upper right", fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    _detail(axes[2], scene, lever, col, path)
+    save_figure(fig, path)
+
+
+def _detail(ax: Any, scene: Scene, lever: LeverScene, col: dict[str, np.ndarray], path: Path):
+    """The first two free periods: the balance angle where it was recorded, over its regimes
+    as named bands, the switches at their located times."""
+    t = col["time"]
+    end = min(float(t[-1]), float(t[0]) + 2.0 * lever.free_period)
+    sel = window(t, float(t[0]), end)
+    names = regime_names(scene, lever.instance)
+    events = of(run_events(path), lever.instance)
+    spans = regime_spans(t[sel], col["regime"][sel], names, events)
+    handles = regime_bands(ax, spans, regime_colours(names), alpha=0.8)
+    recorded(ax, t[sel], col["theta"][sel], color="C0")
+    event_lines([ax], [e[0] for e in events if e[0] <= end], colour="0.4", style=":", width=0.7)
+    ax.set_xlim(float(t[0]), end)
+    ax.set_xlabel("time [s]")
+    unit_label(ax, "balance angle θ", "rad")
+    ax.set_title(
+        "first two free periods: recorded values as dots, switches dotted (events.csv)",
+        fontsize=9,
+        loc="left",
+    )
+    ax.legend(handles=handles, title="regime", loc="upper right", fontsize=8, title_fontsize=8)

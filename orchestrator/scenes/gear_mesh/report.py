@@ -57,6 +57,15 @@ from components.mesh_efficiency import (
     train_mesh_cycle_summary,
 )
 from orchestrator.errors import ScenarioError
+from orchestrator.plotting import (
+    of,
+    regime_bands,
+    regime_colours,
+    regime_names,
+    regime_spans,
+    run_events,
+    save_figure,
+)
 from orchestrator.scenario import Scene
 from orchestrator.scenes.family import Quantity, Reference, quantity
 
@@ -366,9 +375,18 @@ def plot(scene: Scene, header: list[str], data: np.ndarray, path: Path) -> None:
     if f"{p}.cycle_efficiency" in col:
         twin = ax.twinx()
         twin.plot(deg, col[f"{p}.cycle_efficiency"], color="C2", lw=0.9)
-        twin.set_ylabel("output / input work", color="C2")
+        twin.set_ylabel("output / input work [1]", color="C2")
     ax.set_xlabel("driver angle [deg]" + (" (roll angle)" if ms.family == "involute" else ""))
     ax.grid(True, alpha=0.3)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    # The contact regimes behind the torque, switching at their located times (events.csv)
+    # drawn at the driver angle of those times.
+    t = col["time"]
+    names = regime_names(scene, p)
+    spans = regime_spans(t, col[f"{p}.regime"], names, of(run_events(path), p))
+    at = [(np.interp(a, t, deg), np.interp(b, t, deg), n) for a, b, n in spans]
+    handles = regime_bands(ax, at, regime_colours(names), alpha=0.6)
+    ax.legend(
+        handles=handles, fontsize=8, loc="lower left", bbox_to_anchor=(0.0, 1.0), ncol=3,
+        frameon=False, title="contact regimes (bands):", title_fontsize=8, alignment="left",
+    )  # fmt: skip
+    save_figure(fig, path)

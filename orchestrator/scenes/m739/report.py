@@ -17,9 +17,23 @@ from typing import Any
 import numpy as np
 
 from components.gear_train import TRAIN_REGIME_NAMES
-from components.m739_data import LBF, M739
+from components.m739_data import M739
 from components.units import RPM_PER_RAD_S
 from components.verge_escapement import FREE, REGIME_NAMES
+from orchestrator.plotting import (
+    event_lines,
+    of,
+    pyplot,
+    recorded,
+    regime_colours,
+    regime_names,
+    regime_spans,
+    regime_strip,
+    run_events,
+    save_figure,
+    unit_label,
+    window,
+)
 from orchestrator.scenario import Scene
 from orchestrator.scenes.family import Quantity, Reference, quantity
 from orchestrator.scenes.m739.design import scene_design
@@ -191,48 +205,184 @@ def reference_from(result: Any, train: str, verge: str) -> Reference:
 
 
 def plot(scene: Scene, header: list[str], data: np.ndarray, path: Path) -> None:
-    """Verge and escape-wheel motion over the first cycles (about 3 teeth)."""
-    fig, _, _ = escapement_figure(scene, header, data, extra_panels=0)
-    save_figure(fig, f"{scene.name}: verge and escape-wheel motion, first cycles", path)
+    """The whole run (escape-wheel turns to arming, its speed, impacts per tooth) above the
+    first teeth in detail (regimes, angles, speeds, normal force, impacts)."""
+    train, _ = instance_names(scene)
+    t_arm = arming_time(scene, data[:, 0], data[:, header.index(f"{train}.phi")])
+    escapement_plot(scene, header, data, path, f"{scene.name}: M739 S&A, rotor-gear train", t_arm)
 
 
-def escapement_figure(scene: Scene, header: list[str], data: np.ndarray, extra_panels: int):
-    """The first 2.2 ms: angles, speeds, and PN with the verge regime, above ``extra_panels``
-    empty panels.  Returns (figure, axes, (ms, columns restricted to the window))."""
-    import matplotlib
+#: Teeth of the escape wheel shown in the detail window, from the start of the run.
+DETAIL_TEETH = 3
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
 
+def escapement_plot(
+    scene: Scene,
+    header: list[str],
+    data: np.ndarray,
+    path: Path,
+    title: str,
+    t_arm: float | None,
+    extra: Any = None,
+) -> None:
+    """The plot of a spin-driven train and verge escapement armed at ``t_arm`` (None: not
+    armed).  ``extra(axes, ms, col)`` draws on further detail panels (as many as its
+    ``panels`` attribute says)."""
+    plt = pyplot()
     train, verge = instance_names(scene)
     col = {name: data[:, i] for i, name in enumerate(header)}
     t = col["time"]
-    window = t <= min(t[-1], 2.2e-3)
-    col = {name: values[window] for name, values in col.items()}
-    rows = 3 + extra_panels
-    fig, axes = plt.subplots(rows, 1, figsize=(9, 8 + 2 * extra_panels), sharex=True)
-    ms = col["time"] * 1e3
-    axes[0].plot(ms, np.degrees(col[f"{train}.phi"]), label="escape wheel (cumulative)")
-    axes[0].set_ylabel("angle [deg]")
-    ax2 = axes[0].twinx()
-    ax2.plot(ms, np.degrees(col[f"{verge}.psi"]), color="C1", label="verge")
-    ax2.set_ylabel("verge angle [deg]", color="C1")
-    axes[1].plot(ms, col[f"{train}.phi_dot"], label="escape wheel")
-    axes[1].plot(ms, col[f"{verge}.psi_dot"], label="verge")
-    axes[1].set_ylabel("speed [rad/s]")
-    axes[1].legend(loc="upper right")
-    axes[2].plot(ms, col[f"{verge}.PN"] / LBF, label="PN")
-    axes[2].step(ms, col[f"{verge}.regime"], where="post", color="grey", label="regime")
-    axes[2].set_ylabel("PN [lb] / regime")
-    axes[2].legend(loc="upper right")
+    events = run_events(path)
+    phi = col[f"{train}.phi"]
+    pitch = 2.0 * math.pi / M739.n_teeth
+    impacts = _impacts(events, verge, t, col[f"{verge}.impact_count"])
+    detail_end = crossing_time(t, phi - phi[0], DETAIL_TEETH * pitch) or float(t[-1])
+    panels = getattr(extra, "panels", 0)
+    fig = plt.figure(figsize=(11, 15 + 1.8 * panels), layout="constrained")
+    top, bottom = fig.subfigures(2, 1, height_ratios=(3.2, 5.2 + 1.4 * panels))
+    verge_colours = regime_colours(regime_names(scene, verge))
+    _overview(top, scene, t, phi, col[f"{train}.phi_dot"], pitch, impacts, t_arm, detail_end)
+    _impact_bars(top.axes[2], t, phi, pitch, impacts, verge_colours)
+    heights = (0.5, 1, 1, 1.2, 1, *(1.1,) * panels)
+    axes = bottom.subplots(len(heights), 1, sharex=True, height_ratios=heights)
+    sel = window(t, t[0], detail_end)
+    ms, cols = 1e3 * t[sel], {name: v[sel] for name, v in col.items()}
+    rows = []
+    for instance, label, first in ((verge, "verge", 0), (train, "train", 3)):
+        names = regime_names(scene, instance)
+        spans = regime_spans(ms * 1e-3, cols[f"{instance}.regime"], names, of(events, instance))
+        rows.append((label, spans, regime_colours(names, first)))
+    regime_strip(axes[0], rows, scale=1e3)
+    recorded(axes[1], ms, np.degrees(cols[f"{train}.phi"]), color="C0")
+    unit_label(axes[1], "escape wheel φ", "deg")
+    recorded(axes[2], ms, np.degrees(cols[f"{verge}.psi"]), color="C1")
+    unit_label(axes[2], "verge ψ", "deg")
+    recorded(axes[3], ms, cols[f"{train}.phi_dot"], color="C0", label="escape wheel dφ/dt")
+    recorded(axes[3], ms, cols[f"{verge}.psi_dot"], color="C1", label="verge dψ/dt")
+    unit_label(axes[3], "speed", "rad/s")
+    axes[3].legend(loc="upper left", bbox_to_anchor=(1.005, 1.0), fontsize=8, frameon=False)
+    recorded(axes[4], ms, cols[f"{verge}.PN"], color="C2")
+    unit_label(axes[4], "tooth normal force PN", "N")
+    if extra is not None:
+        extra(axes[5:], ms, cols)
+    hit = [ti for ti, _ in impacts if t[0] <= ti <= detail_end]
+    release = [e[0] for e in of(events, verge) if e[3] == REGIME_NAMES[FREE]]
+    release = [ti for ti in release if ti <= detail_end]
+    event_lines(axes[1:], release, 1e3, colour="0.45", style="--", width=0.7)
+    event_lines(axes[1:], hit, 1e3, colour="C3", width=1.0)
+    bottom.suptitle(f"the first {DETAIL_TEETH} teeth in detail")
+    axes[1].set_title(
+        "recorded values as dots; red lines: impacts, "
+        "dashed: the verge leaves the tooth (located times, events.csv)",
+        fontsize=9,
+        loc="left",
+    )
+    for ax in axes[1:]:
+        ax.grid(True, alpha=0.3)
     axes[-1].set_xlabel("time [ms]")
-    return fig, axes, (ms, col)
+    axes[-1].set_xlim(1e3 * t[0], 1e3 * detail_end)
+    save_figure(fig, path, title)
 
 
-def save_figure(fig: Any, title: str, path: Path) -> None:
-    import matplotlib.pyplot as plt
+def _impacts(events: list, verge: str, t: np.ndarray, count: np.ndarray) -> list[tuple[float, str]]:
+    """(time, pallet) of each impact: the verge's located switches from free motion onto a
+    pallet, else the rows whose recorded impact count rose (pallet unknown)."""
+    free = REGIME_NAMES[FREE]
+    located = [(e[0], e[3]) for e in of(events, verge) if e[2] == free]
+    if located:
+        return located
+    rose = np.nonzero(np.diff(count) > 0)[0] + 1
+    return [(float(t[k]), "impact") for k in rose]
 
-    fig.suptitle(title)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+
+def _tooth_passes(t: np.ndarray, phi: np.ndarray, pitch: float) -> np.ndarray:
+    """The start time and the times the escape wheel has turned one more tooth pitch."""
+    teeth = int((phi[-1] - phi[0]) / pitch)
+    passes = [crossing_time(t, phi - phi[0], k * pitch) for k in range(1, teeth + 1)]
+    return np.array([t[0], *[x for x in passes if x is not None]])
+
+
+def _impact_bars(
+    ax: Any,
+    t: np.ndarray,
+    phi: np.ndarray,
+    pitch: float,
+    impacts: list[tuple[float, str]],
+    colours: dict[str, str],
+) -> None:
+    """Impacts in each tooth's passage, by the pallet struck, stacked over its duration."""
+    edges = _tooth_passes(t, phi, pitch)
+    if len(edges) < 2:
+        return
+    tooth = np.searchsorted(edges, [ti for ti, _ in impacts], side="right") - 1
+    bottom = np.zeros(len(edges) - 1)
+    for kind in dict.fromkeys(kind for _, kind in impacts):
+        mine = [k for k, (_, kd) in zip(tooth, impacts, strict=True) if kd == kind]
+        n = np.bincount([k for k in mine if 0 <= k < len(bottom)], minlength=len(bottom))
+        ax.stairs(
+            bottom + n,
+            1e3 * edges,
+            baseline=bottom.copy(),
+            fill=True,
+            color=colours.get(kind, "C4"),
+            label=f"onto {kind}",
+        )
+        bottom += n
+    ax.legend(loc="upper left", bbox_to_anchor=(1.005, 1.0), fontsize=8, frameon=False)
+
+
+def _overview(
+    fig: Any,
+    scene: Scene,
+    t: np.ndarray,
+    phi: np.ndarray,
+    phi_dot: np.ndarray,
+    pitch: float,
+    impacts: list[tuple[float, str]],
+    t_arm: float | None,
+    detail_end: float,
+) -> None:
+    """Escape-wheel turns against time up to arming, its speed (recorded, and the mean over
+    each tooth), impacts per tooth by pallet."""
+    axes = fig.subplots(3, 1, sharex=True, height_ratios=(1.4, 1, 0.8))
+    ms = 1e3 * t
+    axes[0].plot(ms, phi / (2.0 * math.pi), color="C0", lw=1.2, label="escape wheel")
+    unit_label(axes[0], "escape-wheel angle", "turn")
+    level = _arming_angle(scene) / (2.0 * math.pi)
+    if scene.stop_when is not None and ".".join(scene.stop_when.signal).endswith(".phi"):
+        axes[0].axhline(level, color="C3", ls=":", lw=1, label="arming angle")
+    if t_arm is not None:
+        for ax in axes:
+            ax.axvline(1e3 * t_arm, color="C3", lw=1.2)
+        axes[0].annotate(
+            f"armed at {1e3 * t_arm:.2f} ms, {turns_to_arm(scene, t_arm):.2f} projectile turns",
+            (1e3 * t_arm, 0.5 * float(phi[-1]) / (2.0 * math.pi)),
+            xytext=(-8, 0),
+            textcoords="offset points",
+            ha="right",
+            color="C3",
+            fontsize=9,
+        )
+    axes[0].legend(loc="upper left", fontsize=8)
+    per_turn = turns_to_arm(scene, 1e-3)  # projectile turns per millisecond
+    if per_turn > 0.0:
+        sec = axes[0].secondary_xaxis(
+            "top", functions=(lambda x: x * per_turn, lambda n: n / per_turn)
+        )
+        sec.set_xlabel("projectile turns")
+    axes[1].plot(ms, phi_dot, ".", ms=1.5, color="0.65", label="recorded")
+    edges = _tooth_passes(t, phi, pitch)
+    if len(edges) > 1:
+        mean = pitch / np.diff(edges)
+        axes[1].stairs(
+            mean, 1e3 * edges, baseline=None, color="C0", lw=1.5, label="mean over each tooth"
+        )
+    unit_label(axes[1], "escape-wheel speed", "rad/s")
+    axes[1].legend(loc="upper left", fontsize=8)
+    axes[2].set_ylabel("impacts per tooth")
+    axes[2].set_xlabel("time [ms]")
+    for ax in axes:
+        ax.axvspan(1e3 * t[0], 1e3 * detail_end, color="0.9", zorder=0)
+        ax.grid(True, alpha=0.3)
+    axes[0].text(1e3 * detail_end, 0.0, " detail below", fontsize=8, va="bottom", color="0.4")
+    fig.suptitle("whole run")

@@ -37,6 +37,19 @@ from components.rssr_kinematics import ExactRSSR, rocker_extremes
 from components.sprag_clutch import MODEL_HERTZ, MODEL_LUMPED, REGIME_ENGAGED, SpragClutch
 from components.sprag_clutch import REGIME_NAMES as CLUTCH_NAMES
 from components.units import RPM
+from orchestrator.plotting import (
+    event_lines,
+    of,
+    pyplot,
+    recorded,
+    regime_colours,
+    regime_names,
+    regime_spans,
+    regime_strip,
+    run_events,
+    save_figure,
+    unit_label,
+)
 from orchestrator.scenario import Scene
 from orchestrator.scenes.family import Quantity, Reference, quantity
 from orchestrator.scenes.press_feed.monolithic import (
@@ -338,42 +351,57 @@ def sampled_events(
 
 # -- plot ------------------------------------------------------------------------------------------
 def plot(scene: Scene, header: list[str], data: np.ndarray, path: Path) -> None:
-    """Clutch windup and coupler strain against crank angle, one line per crank cycle."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+    """Over the crank cycles: the regimes of drive, clutch and load as named bands, the feed
+    roll angle, the clutch windup and torque and the coupler strain, switches at their
+    located times."""
+    plt = pyplot()
     fs = feed_scene(scene)
     col = {name: data[:, i] for i, name in enumerate(header)}
-    t = col["time"] - scene.start
-    phi_deg = np.degrees(fs.crank_start() + fs.omega * t)
-    cycle = np.floor(t / fs.period + 1e-12).astype(int)
-    x = phi_deg - 360.0 * cycle
-    fig, axes = plt.subplots(2, 1, figsize=(8, 6.5), sharex=True)
+    t = col["time"]
+    events = run_events(path)
     strain = col.get(f"{fs.drive}.strain")
-    for c in np.unique(cycle):
-        sel = cycle == c
-        if sel.sum() < 2:
-            continue
-        label = "start-up" if c == 0 else f"cycle {c + 1}"
-        axes[0].plot(x[sel], 1e3 * col[f"{fs.clutch}.windup"][sel], label=label)
-        if strain is not None:
-            axes[1].plot(x[sel], 1e6 * strain[sel], label=label)
-    axes[0].set_ylabel("clutch windup [mrad]")
-    axes[1].set_ylabel("coupler strain at gauge [µε]")
-    if fs.rigid or strain is None:
-        note = "rigid coupler: no strain" if fs.rigid else "strain not recorded"
-        axes[1].text(0.5, 0.5, note, ha="center", va="center", transform=axes[1].transAxes)
-    axes[1].set_xlabel("crank angle φ1 [deg]")
-    for ax in axes:
+    panels = [
+        (f"{fs.load}.angle", "feed roll angle", "deg", np.degrees),
+        (f"{fs.clutch}.windup", "clutch windup", "mrad", lambda x: 1e3 * x),
+        (f"{fs.clutch}.torque", "clutch torque", "N·m", lambda x: x),
+    ]
+    if strain is not None and not fs.rigid:
+        panels.append((f"{fs.drive}.strain", "coupler strain at gauge", "µε", lambda x: 1e6 * x))
+    panels = [p for p in panels if p[0] in col]
+    fig, axes = plt.subplots(
+        1 + len(panels),
+        1,
+        figsize=(11, 2.4 + 2.1 * len(panels)),
+        sharex=True,
+        height_ratios=(0.8, *(1.0,) * len(panels)),
+        layout="constrained",
+    )
+    rows = []
+    for k, (instance, label) in enumerate(
+        ((fs.drive, "drive"), (fs.clutch, "clutch"), (fs.load, "load"))
+    ):
+        names = regime_names(scene, instance)
+        spans = regime_spans(t, col[f"{instance}.regime"], names, of(events, instance))
+        rows.append((label, spans, regime_colours(names, 2 * k)))
+    regime_strip(axes[0], rows)
+    for ax, (column, what, unit, convert) in zip(axes[1:], panels, strict=True):
+        recorded(ax, t, convert(col[column]), color="C0")
+        unit_label(ax, what, unit)
         ax.grid(True, alpha=0.3)
-        if ax.get_lines():
-            ax.legend(fontsize=8)
-    fig.suptitle(f"{scene.name}: clutch windup and coupler strain")
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    event_lines(axes[1:], [e[0] for e in events], colour="0.5", style=":", width=0.7)
+    cycles = np.arange(scene.start, t[-1], fs.period)
+    cycles = cycles[cycles < t[-1] - 1e-9 * fs.period]  # the last row is no cycle's start
+    event_lines(axes, cycles, colour="k", width=1.0)
+    for k, tc in enumerate(cycles):
+        axes[0].text(tc, 1.02, f" cycle {k + 1}", transform=axes[0].get_xaxis_transform())
+    axes[-1].set_xlabel("time [s]")
+    axes[-1].set_xlim(t[0], t[-1])
+    axes[1].set_title(
+        "black: crank cycle starts; dotted: regime switches (located times, events.csv)",
+        fontsize=9,
+        loc="left",
+    )
+    save_figure(fig, path, f"{scene.name}: press roll feed over {len(cycles)} crank cycles")
 
 
 # -- monolithic reference --------------------------------------------------------------------------

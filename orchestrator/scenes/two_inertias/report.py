@@ -6,9 +6,12 @@ oscillator with the reduced inertia J_a J_b / (J_a + J_b).
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
 from components.rotational import damped_oscillator_transition
+from orchestrator.plotting import column_unit, pyplot, recorded, save_figure, unit_label
 from orchestrator.scenario import Scene
 from orchestrator.scenes.family import Reference
 
@@ -76,3 +79,25 @@ def two_inertias_reference(scene: Scene) -> Reference:
 
     final = signals(np.array([scene.stop]))
     return Reference(headline={"final_angle_a": float(final[f"{a}.phi"][0])}, signals=signals)
+
+
+def plot(scene: Scene, header: list[str], data: np.ndarray, path: Path) -> None:
+    """Both bodies' angles and speeds, and the coupling torque, each on its own axis."""
+    a = scene.report_options.get("body_a", "a")
+    b = scene.report_options.get("body_b", "b")
+    col = {name: data[:, i] for i, name in enumerate(header)}
+    t = col["time"]
+    panels = [("angle", "phi"), ("speed", "w"), ("coupling torque", "tau")]
+    panels = [(q, v) for q, v in panels if f"{a}.{v}" in col or f"{b}.{v}" in col]
+    fig, axes = pyplot().subplots(len(panels), 1, figsize=(9, 2.6 * len(panels)), sharex=True)
+    for ax, (quantity, variable) in zip(np.atleast_1d(axes), panels, strict=True):
+        unit = ""
+        for k, body in enumerate((a, b)):
+            if f"{body}.{variable}" in col:
+                recorded(ax, t, col[f"{body}.{variable}"], color=f"C{k}", label=f"{body}")
+                unit = column_unit(scene, f"{body}.{variable}")
+        unit_label(ax, quantity, unit)
+        ax.legend(loc="upper right", fontsize=8)
+        ax.grid(True, alpha=0.3)
+    np.atleast_1d(axes)[-1].set_xlabel("time [s]")
+    save_figure(fig, path, f"{scene.name}: two inertias on a spring-damper")
