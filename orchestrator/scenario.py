@@ -456,7 +456,9 @@ class _Loader:
                 if _takes(component, model, shared_parameters().get(name)) or _designs(
                     component, name
                 ):
-                    if name in params:
+                    if name in params and not _takes(
+                        component, model, shared_parameters().get(name)
+                    ):
                         raise self.fail(
                             f"{key}.parameters.{name}",
                             f"{name} is a quantity of the design, stated for the scene "

@@ -223,7 +223,9 @@ def test_option_values_checked_at_load(scene: Path, key: str, value, fragment: s
             "spin rate",
         ),
         (M739, {"fmus.train.parameters.mu": 0.2}, "fmus.train.parameters.mu", "as parameters.mu"),
-        (M739, {"parameters.mu1": 0.2}, "parameters.mu1", "expected one of ['mu', 'spin']"),
+        # A design quantity is stated once: for the scene, or for the FMU that takes it.
+        (M739, {"parameters.mu1": 0.2}, "fmus.verge.parameters.mu1", "state it once"),
+        (M739, {"parameters.v_capture": 0.2}, "parameters.v_capture", "expected one of"),
         (TWO, {"parameters.spin": "0 rpm"}, "parameters.spin", "no FMU of the scene shares"),
         (M739, {"parameters.spin": "-1 rpm"}, "parameters.spin", "outside the valid range"),
     ],
