@@ -24,6 +24,7 @@ from .base import (
     ComponentError,
     SnapshotPlan,
     Variable,
+    design_parameter,
     rate_input,
 )
 from .press_feed_data import APP_H_J_O5, LBF_IN, ROLLER_RADIUS
@@ -79,17 +80,17 @@ class BrakeLoad(Component):
     SNAPSHOT = SnapshotPlan()  # its state is scalars: shared, not pickled
 
     VARIABLES = (
-        Variable(
+        design_parameter(
             "j",
-            "parameter",
             "kg.m2",
             APP_H_J_O5,
-            "shaft + referred strip inertia J_o5",
+            "shaft + referred strip inertia",
+            "Xu: J_o5",
             min=0.0,
             exclusive_min=True,
         ),
-        Variable(
-            "brake_torque", "parameter", "N.m", 160.0 * LBF_IN, "friction torque T_b", min=0.0
+        design_parameter(
+            "brake_torque", "N.m", 160.0 * LBF_IN, "friction torque", "Xu: T_b", min=0.0
         ),
         Variable(
             "roller_radius",

@@ -20,7 +20,7 @@ Energy: the crank delivers ``P_in = rhoA F1 q' + (J_o4 phi4e'' - T) v_r`` where
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from .base import (
     COMMON_OUTPUTS,
@@ -28,19 +28,21 @@ from .base import (
     ComponentError,
     SnapshotPlan,
     Variable,
+    design_parameter,
     rate_input,
 )
+from .coupler_inertia import computed_inertia
+from .design_rules import raise_first
 from .event_integration import advance, integration_step_control, integration_variables
 from .press_feed_data import (
     APP_H_FOURIER,
-    COUPLER_DAMPING_FACTOR,
     COUPLER_STANDARD,
-    IN,
     J_O4,
     LINKAGE_TABLE1,
     BentCoupler,
     RSSRLinkage,
 )
+from .press_feed_rules import drive_violations
 from .rssr_kinematics import ExactRSSR, FourierRocker, rocker_extremes
 from .units import RPM
 
@@ -67,12 +69,13 @@ def coupler_stiffness(c: BentCoupler) -> float:
 
 
 def coupler_rho_a(c: BentCoupler) -> float:
-    """Mass per length; App. G (G.9) adds rho_M = 0.05 M / A for a mass clamped at B.
+    """Mass per length; App. G (G.9) adds rho_M = f M / A for a mass clamped at B.
 
-    The 0.05 is per inch: it stands for 1/[(V2s1 + V2s2 + sin^2 2a) L] = 1/17.67 in.
+    The printed f = 0.05 is per inch: about 1/[(V2s1 + V2s2 + sin^2 2a) L + P1] = 1/20.3 in
+    (components.coupler_inertia computes it from the geometry).
     """
     area = tube_section(c)[0]
-    return c.density * area + 0.05 / IN * c.lumped_mass
+    return c.density * area + c.lumped_factor * c.lumped_mass
 
 
 def coupler_modal_mass(c: BentCoupler) -> float:
@@ -84,8 +87,9 @@ def coupler_modal_mass(c: BentCoupler) -> float:
 
 
 def coupler_damping(c: BentCoupler) -> float:
-    """Modal viscous damping 0.45 L C_co (18.e) [N.s/m]."""
-    return COUPLER_DAMPING_FACTOR * c.length * c.c_co
+    """Modal viscous damping 0.45 L C_co (18.e) [N.s/m] (the factor exactly 3 - 8/pi, B.7,
+    where the coupler's inertia is computed from the geometry)."""
+    return c.damping_factor * c.length * c.c_co
 
 
 def strain_factors(c: BentCoupler) -> tuple[float, float]:
@@ -233,6 +237,24 @@ class _CouplerMotion:
         return y
 
 
+def with_inertia(
+    linkage: RSSRLinkage,
+    coupler: BentCoupler,
+    f1: tuple[float, float, float],
+    computed: float,
+) -> tuple[BentCoupler, tuple[float, float, float]]:
+    """The coupler and F1 coefficients the drive uses: as given (``computed`` = 0: Run 1's
+    printed P1, F1, 0.05/in and 0.45), or P1, F1, the lumped-mass and damping factors
+    computed from the linkage and coupler (``computed`` = 1, components.coupler_inertia)."""
+    if computed < 0.5:
+        return coupler, f1
+    ci = computed_inertia(linkage, coupler.alpha, coupler.length)
+    out = replace(
+        coupler, p1=ci.p1, lumped_factor=ci.lumped_factor, damping_factor=ci.damping_factor
+    )
+    return out, ci.f1
+
+
 # -- the component ----------------------------------------------------------------------
 _T1 = LINKAGE_TABLE1
 _C = COUPLER_STANDARD
@@ -276,67 +298,101 @@ class CrankCouplerDrive(Component):
             min=0.0,
             max=1.0,
         ),
-        Variable("a1", "parameter", "m", _T1.a1, "crank length", min=0.0, exclusive_min=True),
-        Variable("a3", "parameter", "m", _T1.a3, "coupler chord AC", min=0.0, exclusive_min=True),
-        Variable("a4", "parameter", "m", _T1.a4, "rocker length", min=0.0, exclusive_min=True),
+        design_parameter("a1", "m", _T1.a1, "crank length", "Xu: a1", min=0.0, exclusive_min=True),
+        design_parameter(
+            "a3", "m", _T1.a3, "coupler chord AC", "Xu: a3", min=0.0, exclusive_min=True
+        ),
+        design_parameter("a4", "m", _T1.a4, "rocker length", "Xu: a4", min=0.0, exclusive_min=True),
         # Frame offsets are signed distances along the joint axes (Hartenberg-Denavit).
-        Variable("s1", "parameter", "m", _T1.s1, "frame offset s1"),
-        Variable("s2", "parameter", "m", _T1.s2, "frame offset s2"),
-        Variable("s3", "parameter", "m", _T1.s3, "frame offset s3"),
-        Variable(
+        design_parameter("s1", "m", _T1.s1, "frame offset s1", "Xu: s1"),
+        design_parameter("s2", "m", _T1.s2, "frame offset s2", "Xu: s2"),
+        design_parameter("s3", "m", _T1.s3, "frame offset s3", "Xu: s3"),
+        design_parameter(
             "alpha",
-            "parameter",
             "rad",
             _C.alpha,
             "coupler half bend angle",
+            "Xu: alpha",
             min=0.0,
             max=0.5 * math.pi,
         ),
-        Variable(
-            "L", "parameter", "m", _C.length, "coupler section length", min=0.0, exclusive_min=True
+        design_parameter(
+            "L", "m", _C.length, "coupler section length", "Xu: L", min=0.0, exclusive_min=True
         ),
-        Variable(
+        design_parameter(
             "d_outer",
-            "parameter",
             "m",
             _C.d_outer,
             "coupler tube outer diameter",
+            "Xu: D_o",
             min=0.0,
             exclusive_min=True,
         ),
-        Variable("d_inner", "parameter", "m", _C.d_inner, "coupler tube inner diameter", min=0.0),
-        Variable(
+        design_parameter(
+            "d_inner", "m", _C.d_inner, "coupler tube inner diameter", "Xu: D_i", min=0.0
+        ),
+        design_parameter(
             "youngs",
-            "parameter",
             "Pa",
             _C.youngs,
             "coupler Young's modulus",
+            "Xu: E",
             min=0.0,
             exclusive_min=True,
         ),
-        Variable(
+        design_parameter(
             "density",
-            "parameter",
             "kg/m3",
             _C.density,
             "coupler density",
+            "Xu: rho",
             min=0.0,
             exclusive_min=True,
         ),
-        Variable(
-            "c_co", "parameter", "N.s/m2", _C.c_co, "coupler damping per unit length", min=0.0
+        design_parameter(
+            "c_co", "N.s/m2", _C.c_co, "coupler damping per unit length", "Xu: C_co", min=0.0
         ),
-        Variable("p1", "parameter", "m", _C.p1, "mean of P1 (B.17)", min=0.0),
-        Variable(
-            "gauge_x1", "parameter", "m", _C.gauge_x1, "strain gauge position from A", min=0.0
+        Variable("p1", "parameter", "m", _C.p1, "mean of P1 (B.17) (coupler_inertia = 0)", min=0.0),
+        design_parameter(
+            "gauge_x1", "m", _C.gauge_x1, "strain gauge position from A", "Xu: x1", min=0.0
         ),
-        Variable("lumped_mass", "parameter", "kg", 0.0, "mass clamped at B (App. G)", min=0.0),
-        Variable("j_o4", "parameter", "kg.m2", J_O4, "rocker + clutch input inertia", min=0.0),
-        Variable("f1_a0", "parameter", "m2", APP_H_FOURIER.f1[0], "F1/phi1dot^2 constant a10"),
-        Variable("f1_a1", "parameter", "m2", APP_H_FOURIER.f1[1], "F1/phi1dot^2 cos term a11"),
-        Variable("f1_b1", "parameter", "m2", APP_H_FOURIER.f1[2], "F1/phi1dot^2 sin term b11"),
+        design_parameter("lumped_mass", "kg", 0.0, "mass clamped at B (App. G)", "Xu: M", min=0.0),
+        design_parameter(
+            "j_o4", "kg.m2", J_O4, "rocker + clutch input inertia", "Xu: J_o4", min=0.0
+        ),
+        Variable(
+            "f1_a0",
+            "parameter",
+            "m2",
+            APP_H_FOURIER.f1[0],
+            "F1/phi1dot^2 constant a10 (coupler_inertia = 0)",
+        ),
+        Variable(
+            "f1_a1",
+            "parameter",
+            "m2",
+            APP_H_FOURIER.f1[1],
+            "F1/phi1dot^2 cos term a11 (coupler_inertia = 0)",
+        ),
+        Variable(
+            "f1_b1",
+            "parameter",
+            "m2",
+            APP_H_FOURIER.f1[2],
+            "F1/phi1dot^2 sin term b11 (coupler_inertia = 0)",
+        ),
         Variable("f2_const", "parameter", "rad/m", 0.0, "constant F2 (0: F2(phi1) exact)", min=0.0),
         Variable("rigid", "parameter", "1", 0.0, "1: rigid coupler (q = 0)", min=0.0, max=1.0),
+        Variable(
+            "coupler_inertia",
+            "parameter",
+            "1",
+            0.0,
+            "0: P1, F1, the lumped-mass and damping factors as printed for Run 1; "
+            "1: computed from the linkage and coupler (App. B, G)",
+            min=0.0,
+            max=1.0,
+        ),
         # The rocker reverses twice a crank turn (0.3 s at 200 rpm): 1 ms steps see it.
         *integration_variables(h_max=1.0e-3),
         Variable("torque", "input", "N.m", 0.0, "torque transmitted by the clutch (>= 0)"),
@@ -367,8 +423,11 @@ class CrankCouplerDrive(Component):
         *COMMON_OUTPUTS,
     )
 
-    def _build(self) -> tuple[DriveModel, BentCoupler]:
-        coupler = BentCoupler(
+    def linkage(self) -> RSSRLinkage:
+        return RSSRLinkage(self.a1, self.a3, self.a4, self.s1, self.s2, self.s3)
+
+    def coupler(self) -> BentCoupler:
+        return BentCoupler(
             length=self.L,
             alpha=self.alpha,
             d_outer=self.d_outer,
@@ -380,13 +439,18 @@ class CrankCouplerDrive(Component):
             gauge_x1=self.gauge_x1,
             lumped_mass=self.lumped_mass,
         )
-        linkage = RSSRLinkage(self.a1, self.a3, self.a4, self.s1, self.s2, self.s3)
+
+    def _build(self) -> tuple[DriveModel, BentCoupler]:
+        linkage = self.linkage()
+        coupler, f1 = with_inertia(
+            linkage, self.coupler(), (self.f1_a0, self.f1_a1, self.f1_b1), self.coupler_inertia
+        )
         return build_drive_model(
             self.crank_rpm(),
             linkage,
             coupler,
             j_o4=self.j_o4,
-            f1=(self.f1_a0, self.f1_a1, self.f1_b1),
+            f1=f1,
             f2_const=self.f2_const if self.f2_const > 0.0 else None,
             rigid=self.rigid > 0.5,
         ), coupler
@@ -398,13 +462,13 @@ class CrankCouplerDrive(Component):
     def initialize(self, t0: float) -> None:
         if self.crank_rpm() <= 0.0:
             raise ComponentError("CrankCouplerDrive: rpm must be positive")
+        # A linkage that does not assemble or a coupler at odds with it is refused, not run.
+        raise_first(drive_violations(self.linkage(), self.coupler(), self.rigid <= 0.5))
         self._m, coupler = self._build()
         self._control = integration_step_control(self, STATE_SCALES)
         self._h_next = 0.0
         self._gauge, self._at_b = strain_factors(coupler)
-        exact = ExactRSSR(
-            RSSRLinkage(self.a1, self.a3, self.a4, self.s1, self.s2, self.s3), self.alpha
-        )
+        exact = ExactRSSR(self.linkage(), self.alpha)
         if self.start_at_max > 0.5:
             self.phi1_0 = rocker_extremes(exact)[1]
         self._t0 = t0

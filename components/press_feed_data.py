@@ -47,6 +47,10 @@ class BentCoupler:
     p1: float  # regime-2 mean of the extra inertia function P1 (B.17) [m]
     gauge_x1: float  # strain gauge position on section 1, measured from A [m]
     lumped_mass: float = 0.0  # App. G: mass clamped at B [kg] (Run 3)
+    # rho_M = lumped_factor M / A (G.9): 0.05 per inch as printed [1/m]
+    lumped_factor: float = 0.05 / IN  # = LUMPED_MASS_FACTOR
+    # the coupler damping 0.45 L C_co (18.e): 0.45 as printed, 3 - 8/pi exactly (B.7)
+    damping_factor: float = 0.45
 
 
 @dataclass(frozen=True)
@@ -91,6 +95,8 @@ COUPLER_RUN3 = replace(COUPLER_STANDARD, lumped_mass=9.1 * LBF / G_STD)
 # Coupler damping: the thesis rounds 3 - 8/pi = 0.4535 to 0.45 (18.e) and fitted C_co to Run 1
 # with 0.45, so the fitted product 0.45 L C_co is what the data carry.
 COUPLER_DAMPING_FACTOR = 0.45
+# App. G (G.9): rho_M = 0.05 M / A, the 0.05 per inch.
+LUMPED_MASS_FACTOR = 0.05 / IN
 
 # Rocker + clutch input shaft (Table 1): 0.1286 lbf.in.s^2.
 J_O4 = 0.1286 * LBF_IN

@@ -21,8 +21,17 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .base import Component, ComponentError, SnapshotPlan, Variable, common_outputs
+from .base import (
+    Component,
+    ComponentError,
+    SnapshotPlan,
+    Variable,
+    common_outputs,
+    design_parameter,
+)
+from .design_rules import raise_first
 from .press_feed_data import C_NL, K_SP, N_DAMP, TABLE4, SpragGeometry
+from .press_feed_rules import sprag_violations
 
 REGIME_OVERRUN = 0
 REGIME_ENGAGED = 1
@@ -249,8 +258,8 @@ class SpragClutch(Component):
             min=0.0,
             max=1.0,
         ),
-        Variable(
-            "k", "parameter", "N.m", K_SP, "lumped stiffness K_sp [N.m/rad^1.5] (model 0)", min=0.0
+        design_parameter(
+            "k", "N.m", K_SP, "lumped stiffness [N.m/rad^1.5] (model 0)", "Xu: K_sp", min=0.0
         ),
         Variable("c_lin", "parameter", "N.m.s/rad", 0.0, "linear damping C_sp (Part I)", min=0.0),
         Variable(
@@ -260,52 +269,52 @@ class SpragClutch(Component):
         Variable(
             "engaged0", "parameter", "1", 1.0, "1: engaged at t0 with zero windup", min=0.0, max=1.0
         ),
-        Variable(
+        design_parameter(
             "r_outer",
-            "parameter",
             "m",
             _S.r_outer,
-            "outer race contact radius R_o",
+            "outer race contact radius",
+            "Xu: R_o",
             min=0.0,
             exclusive_min=True,
         ),
-        Variable(
+        design_parameter(
             "r_inner",
-            "parameter",
             "m",
             _S.r_inner,
-            "inner race contact radius R_i",
+            "inner race contact radius",
+            "Xu: R_i",
             min=0.0,
             exclusive_min=True,
         ),
-        Variable(
+        design_parameter(
             "r_sprag",
-            "parameter",
             "m",
             _S.r_sprag,
-            "sprag profile radius R_s",
+            "sprag profile radius",
+            "Xu: R_s",
             min=0.0,
             exclusive_min=True,
         ),
-        Variable(
-            "sprag_offset", "parameter", "m", _S.offset, "sprag curvature-centre offset a", min=0.0
+        design_parameter(
+            "sprag_offset", "m", _S.offset, "sprag curvature-centre offset", "Xu: a", min=0.0
         ),
-        Variable("n_sprags", "parameter", "1", _S.n_sprags, "number of sprags Z", min=1.0),
-        Variable(
+        design_parameter("n_sprags", "1", _S.n_sprags, "number of sprags", "Xu: Z", min=1.0),
+        design_parameter(
             "strut_inner",
-            "parameter",
             "rad",
             _S.strut_inner,
-            "strut angle alpha",
+            "strut angle",
+            "Xu: alpha (Part III)",
             min=0.0,
             max=0.5 * math.pi,
         ),
-        Variable(
+        design_parameter(
             "strut_outer",
-            "parameter",
             "rad",
             _S.strut_outer,
-            "strut angle beta",
+            "strut angle",
+            "Xu: beta",
             min=0.0,
             max=0.5 * math.pi,
         ),
@@ -394,6 +403,8 @@ class SpragClutch(Component):
                 0.0,
                 0.0,
             )
+            # A sprag that cannot touch both races has no real Hertz stiffness: refused.
+            raise_first(sprag_violations(geom))
             self.k_eff = two_point_hertz(geom).k
         elif self.model == MODEL_LUMPED:
             self.k_eff = self.k

@@ -37,7 +37,7 @@ def test_youngs_modulus_zero_fails_the_press_feed_at_initialization(tmp_path: Pa
     result = run_scene(scene, output_dir=tmp_path, show_progress=False, plots=False)
     assert result.status == "failed"
     assert "FMU 'drive'" in result.message
-    assert "parameter youngs = 0.0 Pa; expected more than 0 (coupler Young's modulus)" in (
+    assert "parameter youngs = 0.0 Pa; expected more than 0 (coupler Young's modulus [Xu: E])" in (
         result.message
     )
 

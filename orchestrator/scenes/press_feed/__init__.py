@@ -11,6 +11,8 @@ FAMILY = SceneFamily(
             Role("BrakeLoad", signals=("regime", "feed_length")),
         ),
     ),
+    design_check="orchestrator.scenes.press_feed.design:check",
+    drawing="orchestrator.scenes.press_feed.drawing:draw",
     analysis="orchestrator.scenes.press_feed.report:analyse",
     plot="orchestrator.scenes.press_feed.report:plot",
     reference="orchestrator.scenes.press_feed.report:reference",

@@ -109,6 +109,7 @@ class FeedOptions:
     j5: float | None = None
     linkage: RSSRLinkage | None = None
     bent_coupler: BentCoupler | None = None  # None: the run's coupler
+    f1: tuple[float, float, float] | None = None  # None: App. H's F1 coefficients
     event_kinematics: str = "fourier"  # linearized model: "exact" | "fourier" rocker for events
     rtol: float = 1e-10
     atol: float = 1e-14
@@ -378,7 +379,8 @@ def _setup(o: FeedOptions):
     j5 = o.j5 if o.j5 is not None else J_O5_SHAFT + run.j_strip
     lk = o.linkage or LINKAGE_TABLE1
     coupler = o.bent_coupler or run.coupler
-    drive = build_drive_model(rpm, lk, coupler, rigid=o.coupler == "rigid")
+    f1 = APP_H_FOURIER.f1 if o.f1 is None else o.f1
+    drive = build_drive_model(rpm, lk, coupler, f1=f1, rigid=o.coupler == "rigid")
     phi1_0 = rocker_extremes(ExactRSSR(lk, coupler.alpha))[1]
     k = K_SP
     if o.clutch == "hertz":

@@ -23,7 +23,12 @@ import numpy as np
 
 from components.brake_load import REGIME_NAMES as BRAKE_NAMES
 from components.brake_load import REGIME_SLIP_FORWARD, REGIME_STICK, BrakeLoad
-from components.crank_coupler_drive import REGIME_FORWARD, CrankCouplerDrive, build_drive_model
+from components.crank_coupler_drive import (
+    REGIME_FORWARD,
+    CrankCouplerDrive,
+    build_drive_model,
+    with_inertia,
+)
 from components.crank_coupler_drive import REGIME_NAMES as DRIVE_NAMES
 from components.press_feed_data import (
     C_NL,
@@ -97,8 +102,16 @@ class FeedScene:
         return RSSRLinkage(p["a1"], p["a3"], p["a4"], p["s1"], p["s2"], p["s3"])
 
     def coupler(self) -> BentCoupler:
+        """The drive's coupler, with P1 and the factors it uses (given or computed)."""
+        return self._inertia()[0]
+
+    def f1(self) -> tuple[float, float, float]:
+        """The F1 Fourier coefficients the drive uses (given or computed) [m^2]."""
+        return self._inertia()[1]
+
+    def _inertia(self) -> tuple[BentCoupler, tuple[float, float, float]]:
         p = self.p_drive
-        return BentCoupler(
+        given = BentCoupler(
             length=p["L"],
             alpha=p["alpha"],
             d_outer=p["d_outer"],
@@ -110,6 +123,8 @@ class FeedScene:
             gauge_x1=p["gauge_x1"],
             lumped_mass=p["lumped_mass"],
         )
+        f1 = (p["f1_a0"], p["f1_a1"], p["f1_b1"])
+        return with_inertia(self.linkage(), given, f1, p["coupler_inertia"])
 
     def crank_start(self) -> float:
         """Crank angle at the scene start [rad], as the drive computes it."""
@@ -426,7 +441,7 @@ def feed_options(scene: Scene):
         coupler = fs.coupler()
         run = 3 if coupler.lumped_mass > 0.0 else 1
         # Any bent coupler of the standard shape (Runs 1-3, or a stiffer/denser tube).
-        for name in ("j_o4", "f1_a0", "f1_a1", "f1_b1", "f2_const"):
+        for name in ("j_o4", "f2_const"):
             need(_same(pd[name], defaults[name]), f"drive parameter {name} must keep its default")
     clutch_defaults = {v.name: float(v.start) for v in SpragClutch.variables("parameter")}
     if pc["model"] == MODEL_HERTZ:
@@ -458,6 +473,7 @@ def feed_options(scene: Scene):
         brake_torque=pl["brake_torque"],
         j5=pl["j"],
         linkage=fs.linkage(),
+        f1=None if fs.rigid else fs.f1(),
         samples_per_cycle=max(1440, math.ceil(fs.period / _REF_SAMPLE)),
     )
 
@@ -554,7 +570,7 @@ def reference(scene: Scene) -> Reference:
     duration = scene.stop - scene.start
     headline = reference_quantities(res, fs, duration, scene.report_options)
     s = res.series
-    drive = build_drive_model(opts.rpm, fs.linkage(), fs.coupler(), rigid=fs.rigid)
+    drive = build_drive_model(opts.rpm, fs.linkage(), fs.coupler(), f1=fs.f1(), rigid=fs.rigid)
     theta4 = np.array(
         [
             drive.phi4_max - (p[0] + p[3] * q)
