@@ -212,7 +212,8 @@ class EscapementStage:
         body.xaxis.label.set_size(7)
         body.yaxis.label.set_size(7)
         (self._contact,) = esc.plot([], [], "o", color="k", ms=4)
-        (self._impact,) = esc.plot([], [], "*", color="red", ms=16, mec="darkred")
+        # The impact star in gold, a colour no part of the mechanism is drawn in.
+        (self._impact,) = esc.plot([], [], "*", color="gold", ms=16, mec="k", mew=0.6)
         self._regime = esc.text(0.02, 0.97, "", transform=esc.transAxes, fontsize=8, va="top")
         self._impact_text = esc.text(
             0.02, 0.03, "", transform=esc.transAxes, fontsize=8, color="darkred"

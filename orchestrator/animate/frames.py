@@ -42,7 +42,11 @@ class Clock:
         return int(np.floor((self.stop - self.start) / self.frame_step + 1e-9)) + 1
 
     def times(self) -> np.ndarray:
-        return self.start + np.arange(self.count) * self.frame_step
+        t = self.start + np.arange(self.count) * self.frame_step
+        # A window of whole frames ends on its stop, not a rounding error before it.
+        if abs(t[-1] - self.stop) < 1e-6 * self.frame_step:
+            t[-1] = self.stop
+        return t
 
     def delays_ms(self) -> Iterator[int]:
         """Each frame's display time in whole hundredths of a second (the GIF's unit), so
