@@ -188,7 +188,7 @@ def main(argv: list[str] | None = None) -> int:
     p.set_defaults(handler=_stability)
 
     p = sub.add_parser("bench", help="run a benchmark (prints ratios against its baseline)")
-    p.add_argument("name", choices=["overhead", "m739", "speed", "supervision"])
+    p.add_argument("name", choices=["overhead", "m739", "speed", "supervision", "animate"])
     p.set_defaults(handler=_bench)
 
     p = sub.add_parser(
@@ -198,6 +198,23 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("run_dir", type=Path, help="the run's results directory (its summary.json)")
     p.add_argument("--json", action="store_true", help="the summary as JSON instead")
     p.set_defaults(handler=_report)
+
+    p = sub.add_parser(
+        "animate",
+        help="animate a run: its mechanism to scale, moving with the recorded angles (GIF, MP4)",
+    )
+    p.add_argument("run_dir", type=Path, help="the run's results directory")
+    p.add_argument("--output", type=Path, help="GIF file (default: RUN_DIR/<scene>.gif)")
+    p.add_argument("--start", help="simulated time to begin at, e.g. '1 ms' (default: 0)")
+    p.add_argument("--stop", help="simulated time to end at, e.g. '5 ms' (default: the end)")
+    p.add_argument("--fps", type=float, default=25.0, help="frames per second (default 25)")
+    p.add_argument("--size", default="880x440", help="WIDTHxHEIGHT in pixels (default 880x440)")
+    pace = p.add_mutually_exclusive_group()
+    pace.add_argument("--slowdown", type=float, help="slow-motion factor (default: the family's)")
+    pace.add_argument("--duration", help="or: how long the window plays, e.g. '10 s'")
+    p.add_argument("--no-mp4", action="store_true", help="no MP4, even where ffmpeg is")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    p.set_defaults(handler=_animate)
 
     args = parser.parse_args(argv)
     return _handled(args.handler, args)
@@ -520,6 +537,56 @@ def _bench(args: argparse.Namespace) -> int:
     from orchestrator.studies.benchmarks import BENCHMARKS
 
     BENCHMARKS[args.name]()
+    return 0
+
+
+def _animate(args: argparse.Namespace) -> int:
+    from orchestrator.animate import AnimationOptions, animate_run
+    from orchestrator.progress import ProgressBar
+    from orchestrator.units import to_si
+
+    def seconds(option: str, text: str | None) -> float | None:
+        if text is None:
+            return None
+        try:
+            return to_si(text, "s")
+        except ValueError as exc:
+            raise ScenarioError(option, "", f"{exc}; expected a time such as '5 ms'") from None
+
+    w, sep, h = args.size.lower().partition("x")
+    if not (sep and w.isdigit() and h.isdigit() and int(w) >= 64 and int(h) >= 64):
+        raise ScenarioError("--size", "", f"{args.size!r}: expected WIDTHxHEIGHT in pixels, "
+                            "each at least 64, e.g. 880x440")  # fmt: skip
+    options = AnimationOptions(
+        start=seconds("--start", args.start),
+        stop=seconds("--stop", args.stop),
+        fps=args.fps,
+        size=(int(w), int(h)),
+        slowdown=args.slowdown,
+        duration=seconds("--duration", args.duration),
+        mp4=not args.no_mp4,
+    )
+
+    bars: list[ProgressBar] = []
+
+    def progress(total: int):  # noqa: ANN202 - a per-frame tick
+        bars.append(ProgressBar(total=total, unit="frame", delay=1.0, leave=False,
+                                disable=args.no_progress))  # fmt: skip
+        return lambda: bars[0].update(1)
+
+    try:
+        made = animate_run(args.run_dir, args.output, options, progress)
+    finally:
+        for bar in bars:
+            bar.close()
+    for note in made.notes:
+        print(f"note: {note}")
+    what = f"{made.gif}" + (f" and {made.mp4}" if made.mp4 else " (no ffmpeg: no MP4)")
+    print(
+        f"{args.run_dir}: animated to {what}: {made.frames} frames of {made.size[0]}x"
+        f"{made.size[1]}, {made.start * 1e3:.6g} .. {made.stop * 1e3:.6g} ms simulated at "
+        f"{made.slowdown:g}x slower, {made.fps:g} frames/s; {made.wall_time:.1f} s"
+    )
     return 0
 
 

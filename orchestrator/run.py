@@ -314,6 +314,9 @@ def _metadata(scene: Scene, fmu_paths: dict[str, Path]) -> dict[str, Any]:
             name: {"file": p.name, "sha256": file_sha256(p), "model": scene.fmus[name].fmu_name}
             for name, p in fmu_paths.items()
         },
+        # The parameters as run (SI, --set overrides applied): what rebuilds the design of a
+        # run's mechanism from its results alone (``mechcosim animate``).
+        "parameters": {name: dict(spec.parameters) for name, spec in scene.fmus.items()},
         "master": {
             "algorithm": scene.master.algorithm,
             own_key: step,
