@@ -544,6 +544,69 @@ static int prepare(char* why) {
     return ok;
 }
 
+/* -- the resource location ------------------------------------------------------------- */
+static int hex_digit(char c) {
+    if (c >= '0' && c <= '9') return c - '0';
+    if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+    if (c >= 'A' && c <= 'F') return c - 'A' + 10;
+    return -1;
+}
+
+/* The resource location as pythonfmu's runtime takes it, "file://" and a plain absolute path
+ * (it strips exactly that prefix).  FMI 2.0 (2.1.6, fmi2Instantiate) gives the location as a
+ * URI (RFC 3986): "file:///p", "file:/p" and "file://localhost/p" name the same directory,
+ * its characters may be percent-escaped ("%20" for a space), and a plain absolute path is
+ * taken as it is. */
+static int resource_path(const char* location, char* out, size_t size, char* why) {
+    const char* path = location;
+    if (strncmp(location, "file:", 5) == 0) {
+        path = location + 5;
+        if (strncmp(path, "//", 2) == 0) {
+            path += 2; /* an authority: empty or localhost, then the absolute path */
+            if (strncmp(path, "localhost/", 10) == 0) path += 9;
+        }
+    }
+    if (path[0] != '/') {
+        snprintf(why, WHY_SIZE,
+                 "fmi2Instantiate: resource location \"%.1024s\" is no file URI of a local "
+                 "absolute path (expected file:///path, file:/path or file://localhost/path)",
+                 location);
+        return 0;
+    }
+    size_t n = (size_t)snprintf(out, size, "file://");
+    for (const char* p = path; *p; ++p) {
+        char c = *p;
+        if (c == '%') {
+            int high = hex_digit(p[1]), low = high < 0 ? -1 : hex_digit(p[2]);
+            if (low < 0) {
+                snprintf(why, WHY_SIZE,
+                         "fmi2Instantiate: resource location \"%.1024s\" has a '%%' that is not "
+                         "followed by two hexadecimal digits", location);
+                return 0;
+            }
+            c = (char)(high * 16 + low);
+            p += 2;
+        }
+        if (c == '\0' || n + 1 >= size) {
+            snprintf(why, WHY_SIZE, "fmi2Instantiate: resource location \"%.1024s\" is %s",
+                     location, c == '\0' ? "a path with an escaped NUL" : "too long");
+            return 0;
+        }
+        out[n++] = c;
+    }
+    out[n] = '\0';
+    /* the runtime reads the name of the slave's module there, and crashes without it */
+    char marker[PATH_MAX + 64];
+    snprintf(marker, sizeof marker, "%s/slavemodule.txt", out + 7);
+    if (access(marker, R_OK) != 0) {
+        snprintf(why, WHY_SIZE,
+                 "fmi2Instantiate: resource location \"%.1024s\" is not this FMU's resources "
+                 "directory (no slavemodule.txt in %.1024s)", location, out + 7);
+        return 0;
+    }
+    return 1;
+}
+
 /* -- FMI 2.0 ---------------------------------------------------------------------------------- */
 EXPORT const char* fmi2GetTypesPlatform(void) { return "default"; }
 
@@ -594,11 +657,14 @@ EXPORT fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, 
             return NULL;
         }
         snprintf(resources, sizeof resources, "file://%s/../../resources", binaries);
-        fmuResourceLocation = resources;
+    } else if (!resource_path(fmuResourceLocation, resources, sizeof resources, why)) {
+        emit(functions, name, fmi2Error, "logStatusError", why);
+        free_instance(i);
+        return NULL;
     }
     /* The runtime logs with debug logging on, always: relay() does the filtering. */
-    i->inner = runtime.fmi2Instantiate(instanceName, fmuType, fmuGUID, fmuResourceLocation,
-                                       &i->relayed, visible, 1);
+    i->inner = runtime.fmi2Instantiate(instanceName, fmuType, fmuGUID, resources, &i->relayed,
+                                       visible, 1);
     if (i->inner == NULL) { /* the runtime has logged why */
         free_instance(i);
         return NULL;

@@ -26,6 +26,7 @@ from foreign_fmus import FOREIGN_DIR, c_compiler, fmi_headers_dir
 
 import fmus.host_loader as host_loader
 from fmus.build import build_fmu
+from fmus.registry import FMU_RECORDS
 from orchestrator.run import run_scene
 from orchestrator.scenario import load_scene
 from orchestrator.studies.crosscheck import ToolRun, agreement
@@ -89,7 +90,9 @@ def outputs(path: Path) -> list:
     return [v for v in md.modelVariables if v.causality == "output" and v.type != "Boolean"]
 
 
-def fmpy_run(path: Path, values: dict, outs: list, step: float, scratch: Path) -> np.ndarray:
+def fmpy_run(
+    path: Path, values: dict, outs: list, step: float, scratch: Path, steps: int = STEPS
+) -> np.ndarray:
     """The C host's "run" lines, by FMPy (a Python host) on the same FMU."""
     md = read_model_description(str(path))
     variables = {v.name: v for v in md.modelVariables}
@@ -119,7 +122,7 @@ def fmpy_run(path: Path, values: dict, outs: list, step: float, scratch: Path) -
         ]
 
     rows = [row(0.0)]
-    for k in range(STEPS):
+    for k in range(steps):
         fmu.doStep(currentCommunicationPoint=k * step, communicationStepSize=step)
         rows.append(row((k + 1) * step))
     fmu.terminate()
@@ -173,6 +176,61 @@ def test_the_full_call_sequence_in_a_c_host_matches_fmpy(host: Path, tmp_path: P
         said = [ln for ln in out if ln.startswith("log ") and f" {name}_d:" in ln]
         assert said[0].startswith(f"log Fatal {name}_d:") and "index out of range" in said[0], said
         assert "fmi2DoStep: the instance failed fatally before" in said[-1], said
+
+
+#: FMI 2.0 resource locations (2.1.6) that name the unpacked FMU's resources/ directory
+RESOURCE_FORMS = {
+    "file:/": "file:{dir}/resources",
+    "file://localhost/": "file://localhost{dir}/resources",
+    "percent-escaped": "file://{escaped}/%72esources",  # %72 is "r"
+}
+
+
+@pytest.mark.parametrize("form", RESOURCE_FORMS)
+def test_every_fmu_runs_at_every_form_of_resource_location(
+    host: Path, tmp_path: Path, form: str
+) -> None:
+    """Each of our FMUs in one C process, instantiated at a resource location written as
+    FMI 2.0 allows (pythonfmu's runtime alone takes only "file://": the others crashed it),
+    stepped as FMPy steps it with "file:///", value for value."""
+    job = ["plain 0 3"]
+    expected = {}
+    for name in FMU_RECORDS:
+        path = build_fmu(name)
+        outs = outputs(path)
+        values = ALONE.get(name, {})
+        step = float(read_model_description(str(path)).defaultExperiment.stepSize)
+        expected[name] = fmpy_run(path, values, outs, step, tmp_path / f"{name}-fmpy", steps=3)
+        unpacked = unpack(path, tmp_path / name).resolve()
+        escaped = "".join(f"%{ord(c):02X}" if c == "_" else c for c in str(unpacked))
+        uri = RESOURCE_FORMS[form].format(dir=unpacked, escaped=escaped)
+        job += fmu_lines(name, path, unpacked, values, outs)
+        job += [f"uri {uri}", f"step {step!r}"]
+    (tmp_path / "job.txt").write_text("\n".join(job) + "\n")
+    out = run_host(host, tmp_path / "job.txt")
+    assert out[-1] == "done 0 failures", out[-20:]
+    for name, reference in expected.items():
+        assert np.array_equal(table(out, f"{name}:run"), reference), name
+
+
+def test_a_resource_location_that_is_no_local_file_is_refused_by_name(
+    host: Path, tmp_path: Path
+) -> None:
+    path = build_fmu("Inertia")
+    unpacked = unpack(path, tmp_path / "x")
+    job = ["plain 0 1", *fmu_lines("i", path, unpacked, {}, []), "uri http://host/resources"]
+    (tmp_path / "job.txt").write_text("\n".join(job + ["step 1e-3"]) + "\n")
+    out = run_host(host, tmp_path / "job.txt")
+    assert "instantiate i returned NULL" in out
+    assert any(
+        ln.startswith("log Error i:") and '"http://host/resources" is no file URI' in ln
+        for ln in out
+    ), out
+    job[-1] = f"uri file://{tmp_path}/resources"  # an existing directory, not the FMU's
+    (tmp_path / "job.txt").write_text("\n".join(job + ["step 1e-3"]) + "\n")
+    out = run_host(host, tmp_path / "job.txt")
+    assert "instantiate i returned NULL" in out
+    assert any("no slavemodule.txt in" in ln for ln in out), out
 
 
 def test_m739_train_and_verge_coupled_in_a_c_host_match_our_jacobi_master(
