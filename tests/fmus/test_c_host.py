@@ -186,30 +186,38 @@ RESOURCE_FORMS = {
 }
 
 
-@pytest.mark.parametrize("form", RESOURCE_FORMS)
-def test_every_fmu_runs_at_every_form_of_resource_location(
-    host: Path, tmp_path: Path, form: str
-) -> None:
-    """Each of our FMUs in one C process, instantiated at a resource location written as
-    FMI 2.0 allows (pythonfmu's runtime alone takes only "file://": the others crashed it),
-    stepped as FMPy steps it with "file:///", value for value."""
-    job = ["plain 0 3"]
-    expected = {}
+@pytest.fixture(scope="module")
+def fmpy_alone(tmp_path_factory: pytest.TempPathFactory) -> dict[str, tuple]:
+    """Each of our FMUs unpacked, and its first 3 steps in FMPy (at "file:///")."""
+    scratch = tmp_path_factory.mktemp("alone")
+    runs = {}
     for name in FMU_RECORDS:
         path = build_fmu(name)
         outs = outputs(path)
         values = ALONE.get(name, {})
         step = float(read_model_description(str(path)).defaultExperiment.stepSize)
-        expected[name] = fmpy_run(path, values, outs, step, tmp_path / f"{name}-fmpy", steps=3)
-        unpacked = unpack(path, tmp_path / name).resolve()
+        reference = fmpy_run(path, values, outs, step, scratch / f"{name}-fmpy", steps=3)
+        unpacked = unpack(path, scratch / name).resolve()
+        lines = fmu_lines(name, path, unpacked, values, outs)
+        runs[name] = (unpacked, lines + [f"step {step!r}"], reference)
+    return runs
+
+
+@pytest.mark.parametrize("form", RESOURCE_FORMS)
+def test_every_fmu_runs_at_every_form_of_resource_location(
+    host: Path, tmp_path: Path, fmpy_alone: dict, form: str
+) -> None:
+    """Each of our FMUs in one C process, instantiated at a resource location written as
+    FMI 2.0 allows (pythonfmu's runtime alone takes only "file://": the others crashed it),
+    stepped as FMPy steps it with "file:///", value for value."""
+    job = ["plain 0 3"]
+    for unpacked, lines, _ in fmpy_alone.values():
         escaped = "".join(f"%{ord(c):02X}" if c == "_" else c for c in str(unpacked))
-        uri = RESOURCE_FORMS[form].format(dir=unpacked, escaped=escaped)
-        job += fmu_lines(name, path, unpacked, values, outs)
-        job += [f"uri {uri}", f"step {step!r}"]
+        job += [*lines, f"uri {RESOURCE_FORMS[form].format(dir=unpacked, escaped=escaped)}"]
     (tmp_path / "job.txt").write_text("\n".join(job) + "\n")
     out = run_host(host, tmp_path / "job.txt")
     assert out[-1] == "done 0 failures", out[-20:]
-    for name, reference in expected.items():
+    for name, (_, _, reference) in fmpy_alone.items():
         assert np.array_equal(table(out, f"{name}:run"), reference), name
 
 
