@@ -100,14 +100,29 @@ class ComponentSlave(Fmi2Slave):
             raise
         self.model = self.component_class()
         self._names: list[str] = []
+        self._types: list[str] = []
+        self._causalities: list[str] = []
         self._inputs: set[int] = set()
         self._feedthrough_stale = False
         self._initializing = False
+        self._initialized = False  # initialization mode left: fixed parameters are fixed
         self._init_stale = False
         self._start_time = 0.0
-        self._not_finite: set[str] = set()  # Reals whose last value set is NaN or inf
+        self._t_end = 0.0  # where the last step ended: the next one starts there
+        self._last_h = 0.0
         for var in self.component_class.VARIABLES:
             self._register(var)
+        reals = {vr for vr, kind in enumerate(self._types) if kind == "Real"}
+        integers = set(range(len(self._types))) - reals
+        settable = {vr for vr, c in enumerate(self._causalities) if c in ("parameter", "input")}
+        self._readable = {"Real": frozenset(reals), "Integer": frozenset(integers)}
+        self._settable_before = {
+            "Real": frozenset(reals & settable),
+            "Integer": frozenset(integers & settable),
+        }
+        self._settable_after = {
+            kind: frozenset(vrs & self._inputs) for kind, vrs in self._settable_before.items()
+        }
 
     def _register(self, var: Any) -> None:
         comp = self.model
@@ -132,15 +147,20 @@ class ComponentSlave(Fmi2Slave):
         if var.causality == "input":
             self._inputs.add(fmi_var.value_reference)
         self._names.append(name)
+        self._types.append("Integer" if var.type == "Integer" else "Real")
+        self._causalities.append(var.causality)
 
     # -- life cycle -------------------------------------------------------------------
     # Outputs must be valid in initialization mode too (a master reads them there to set
     # consistent inputs), so the component is (re)initialized from the current parameters
     # whenever something was set and an output is read, and once more on leaving the mode.
+    # Which call is allowed when is the FMU's loader's to check (fmus/loader/python_loader.c);
+    # what needs the variables (types, fixed parameters, times) is checked here.
     def setup_experiment(self, start_time: float, stop_time: float | None, tolerance: float | None):
         if not math.isfinite(start_time):
-            raise self._refuse(f"setupExperiment: start time {start_time} is not finite")
-        self._start_time = float(start_time)
+            self._refuse(f"fmi2SetupExperiment: start time {start_time} is not finite")
+            return
+        self._start_time = self._t_end = float(start_time)
         # A tolerance the host defines is the internal integration's (FMI 2.0, 4.2.4), within
         # the parameter's range; a value the host then sets for `tolerance` still wins.
         declared = next((v for v in self.component_class.VARIABLES if v.name == "tolerance"), None)
@@ -161,16 +181,19 @@ class ComponentSlave(Fmi2Slave):
             if v.type == "Real" and not math.isfinite(getattr(self.model, v.name))
         ]
         if bad:
-            raise self._refuse(f"initialization: not finite: {', '.join(bad)}")
+            self._refuse(f"fmi2ExitInitializationMode: not finite: {', '.join(bad)}")
+            return
         problem = self.model.parameter_problem()
         if problem is not None:
-            raise self._refuse(f"initialization: {problem}")
-        self._not_finite.clear()
+            self._refuse(f"fmi2ExitInitializationMode: {problem}")
+            return
         self.model.initialize(self._start_time)
         self.model.update_outputs()
         self._initializing = False
+        self._initialized = True
         self._init_stale = False
         self._feedthrough_stale = False
+        self._t_end = self._start_time
 
     def _refresh(self) -> None:
         if self._initializing:
@@ -184,15 +207,18 @@ class ComponentSlave(Fmi2Slave):
 
     def do_step(self, current_time: float, step_size: float) -> bool:
         refusal = ""
+        expected = self._t_end
         if not (math.isfinite(current_time) and math.isfinite(current_time + step_size)):
             refusal = f"time {current_time} or step size {step_size} is not finite"
         elif not step_size > 0.0:
             refusal = f"step size {step_size} is not positive"
-        elif self._not_finite:
-            refusal = f"values set are not finite: {', '.join(sorted(self._not_finite))}"
-        if refusal:  # fmi2Discard, nothing changed: the instance stays usable
-            self._refuse(f"doStep at t = {current_time} refused: {refusal}")
-            return False
+        elif abs(current_time - expected) > TIME_MATCH * max(
+            abs(expected), abs(current_time), self._last_h
+        ):
+            refusal = f"the last step ended at t = {expected!r} s, where the next must start"
+        if refusal:  # fmi2Error, nothing changed
+            self._refuse(f"fmi2DoStep at t = {current_time!r} s refused: {refusal}")
+            return True
         try:
             if self._feedthrough_stale and not self.model.STEP_TAKES_INPUTS:
                 self._refresh()
@@ -203,15 +229,36 @@ class ComponentSlave(Fmi2Slave):
                 f"{type(exc).__name__}: {exc}\n{traceback.format_exc(limit=3)}", Fmi2Status.error
             )
             return False
+        # a component that ends its step at its first event says where (components.early_return)
+        self._t_end = float(getattr(self.model, "t_reached", current_time + step_size))
+        self._last_h = step_size
         return True
 
-    def _refuse(self, message: str) -> FmiCallError:
-        """Log why a call is refused; the result is for the caller to raise, if it must."""
+    def _refuse(self, message: str) -> None:
+        """Refuse the call: log why with fmi2Error, which the FMU's loader answers with."""
         self.log(message, Fmi2Status.error)
-        return FmiCallError(message)
 
-    # -- lean variable access (the hot path of every master step) ----------------------
+    # -- variable access (the hot path of every master step) ---------------------------
+    def _bad_reference(self, function: str, kind: str, vrs: list[int], allowed: frozenset) -> None:
+        """Refuse a call with a value reference that is not in ``allowed``, saying why."""
+        vr = next(vr for vr in vrs if vr not in allowed)
+        if not 0 <= vr < len(self._names):
+            self._refuse(f"{function}: no variable has value reference {vr}")
+            return
+        name, its = self._names[vr], self._types[vr]
+        if its != kind:
+            self._refuse(f"{function}: value reference {vr} is {name}, an {its} (fmi2Get/Set{its})")
+        elif self._causalities[vr] == "output":
+            self._refuse(f"{function}: {name} is an output, which the host cannot set")
+        else:
+            self._refuse(
+                f"{function}: {name} is a fixed parameter, which cannot change after initialization"
+            )
+
     def get_real(self, vrs: list[int]) -> list[float]:
+        if not self._readable["Real"].issuperset(vrs):
+            self._bad_reference("fmi2GetReal", "Real", vrs, self._readable["Real"])
+            return [0.0] * len(vrs)
         if self._feedthrough_stale or self._initializing:
             self._refresh()
         comp = self.model
@@ -219,6 +266,9 @@ class ComponentSlave(Fmi2Slave):
         return [float(getattr(comp, names[vr])) for vr in vrs]
 
     def get_integer(self, vrs: list[int]) -> list[int]:
+        if not self._readable["Integer"].issuperset(vrs):
+            self._bad_reference("fmi2GetInteger", "Integer", vrs, self._readable["Integer"])
+            return [0] * len(vrs)
         if self._feedthrough_stale or self._initializing:
             self._refresh()
         comp = self.model
@@ -226,37 +276,81 @@ class ComponentSlave(Fmi2Slave):
         return [int(getattr(comp, names[vr])) for vr in vrs]
 
     def set_real(self, vrs: list[int], values: list[float]) -> None:
+        settable = (self._settable_after if self._initialized else self._settable_before)["Real"]
+        if not settable.issuperset(vrs):
+            self._bad_reference("fmi2SetReal", "Real", vrs, settable)
+            return
+        if not all(map(math.isfinite, values)):
+            vr, value = next(
+                (r, v) for r, v in zip(vrs, values, strict=True) if not math.isfinite(v)
+            )
+            self._refuse(f"fmi2SetReal: {self._names[vr]} = {value} is not finite")
+            return
         comp = self.model
         names = self._names
-        if not all(map(math.isfinite, values)) or self._not_finite:
-            # Refused at the next step (see do_step), until set to finite values again.
-            for vr, value in zip(vrs, values, strict=True):
-                (self._not_finite.discard if math.isfinite(value) else self._not_finite.add)(
-                    names[vr]
-                )
         for vr, value in zip(vrs, values, strict=True):
             setattr(comp, names[vr], float(value))
         self._feedthrough_stale = self._init_stale = True
 
     def set_integer(self, vrs: list[int], values: list[int]) -> None:
+        settable = (self._settable_after if self._initialized else self._settable_before)["Integer"]
+        if not settable.issuperset(vrs):
+            self._bad_reference("fmi2SetInteger", "Integer", vrs, settable)
+            return
         comp = self.model
         names = self._names
         for vr, value in zip(vrs, values, strict=True):
             setattr(comp, names[vr], int(value))
         self._feedthrough_stale = self._init_stale = True
 
+    # no Boolean or String variables: an empty call is answered, any reference refused
+    def get_boolean(self, vrs: list[int]) -> list[bool]:
+        if vrs:
+            self._bad_reference("fmi2GetBoolean", "Boolean", vrs, frozenset())
+        return [False] * len(vrs)
+
+    def get_string(self, vrs: list[int]) -> list[str]:
+        if vrs:
+            self._bad_reference("fmi2GetString", "String", vrs, frozenset())
+        return [""] * len(vrs)
+
+    def set_boolean(self, vrs: list[int], values: list[bool]) -> None:
+        if vrs:
+            self._bad_reference("fmi2SetBoolean", "Boolean", vrs, frozenset())
+
+    def set_string(self, vrs: list[int], values: list[str]) -> None:
+        if vrs:
+            self._bad_reference("fmi2SetString", "String", vrs, frozenset())
+
     # -- complete state ---------------------------------------------------------------
     def _get_fmu_state(self) -> dict[str, Any]:
         return {
+            "fmu": self.component,
             "component": self.model.get_state(),
             "stale": self._feedthrough_stale,
-            "not_finite": frozenset(self._not_finite),
+            "init_stale": self._init_stale,
+            "phase": (self._initializing, self._initialized),
+            "time": (self._start_time, self._t_end, self._last_h),
         }
 
     def _set_fmu_state(self, state: dict[str, Any]) -> None:
+        owner = state.get("fmu") if isinstance(state, dict) else None
+        if owner != self.component:
+            self._refuse(
+                f"fmi2SetFMUstate: the state is of {owner or 'no FMU of ours'}, "
+                f"not of {self.component}"
+            )
+            return
         self.model.set_state(state["component"])
         self._feedthrough_stale = state["stale"]
-        self._not_finite = set(state["not_finite"])
+        self._init_stale = state["init_stale"]
+        self._initializing, self._initialized = state["phase"]
+        self._start_time, self._t_end, self._last_h = state["time"]
+
+
+#: A step starts where the last ended, up to this relative difference (a host that computes
+#: t_k = k h rather than summing the steps).
+TIME_MATCH = 1e-9
 
 
 def _component_class(path: str) -> type[Component]:

@@ -272,9 +272,8 @@ static void sequence(Fmu* f, double start, int n) {
     f->free_instance(b);
     f->free_instance(c);
 
-    /* An unknown value reference: the runtime answers fmi2Fatal, the instance refuses every
-     * later call with fmi2Error, and freeing it does not crash.  No resource location: the
-     * FMU finds its own. */
+    /* An unknown value reference: fmi2Error, the instance is in the error state and refuses
+     * a step, and freeing it does not crash.  No resource location: the FMU finds its own. */
     snprintf(name, sizeof name, "%s_d", f->name);
     fmi2Component d =
         f->instantiate(name, fmi2CoSimulation, f->guid, NULL, &callbacks, fmi2False, fmi2False);
