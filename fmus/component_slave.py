@@ -247,7 +247,8 @@ class ComponentSlave(Fmi2Slave):
             return
         name, its = self._names[vr], self._types[vr]
         if its != kind:
-            self._refuse(f"{function}: value reference {vr} is {name}, an {its} (fmi2Get/Set{its})")
+            article = "an" if its[0] in "AEIOU" else "a"
+            self._refuse(f"{function}: value reference {vr} is {name}, {article} {its}")
         elif self._causalities[vr] == "output":
             self._refuse(f"{function}: {name} is an output, which the host cannot set")
         else:

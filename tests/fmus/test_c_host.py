@@ -181,6 +181,69 @@ def test_the_full_call_sequence_in_a_c_host_matches_fmpy(host: Path, tmp_path: P
         ], said
 
 
+#: FMI 2.0 resource locations (2.1.6) that name the unpacked FMU's resources/ directory
+RESOURCE_FORMS = {
+    "file:/": "file:{dir}/resources",
+    "file://localhost/": "file://localhost{dir}/resources",
+    "percent-escaped": "file://{escaped}/%72esources",  # %72 is "r"
+}
+
+
+@pytest.fixture(scope="module")
+def fmpy_alone(tmp_path_factory: pytest.TempPathFactory) -> dict[str, tuple]:
+    """Each of our FMUs unpacked, and its first 3 steps in FMPy (at "file:///")."""
+    scratch = tmp_path_factory.mktemp("alone")
+    runs = {}
+    for name in FMU_RECORDS:
+        path = build_fmu(name)
+        outs = outputs(path)
+        values = ALONE.get(name, {})
+        step = float(read_model_description(str(path)).defaultExperiment.stepSize)
+        reference = fmpy_run(path, values, outs, step, scratch / f"{name}-fmpy", steps=3)
+        unpacked = unpack(path, scratch / name).resolve()
+        lines = fmu_lines(name, path, unpacked, values, outs)
+        runs[name] = (unpacked, lines + [f"step {step!r}"], reference)
+    return runs
+
+
+@pytest.mark.parametrize("form", RESOURCE_FORMS)
+def test_every_fmu_runs_at_every_form_of_resource_location(
+    host: Path, tmp_path: Path, fmpy_alone: dict, form: str
+) -> None:
+    """Each of our FMUs in one C process, instantiated at a resource location written as
+    FMI 2.0 allows (pythonfmu's runtime alone takes only "file://": the others crashed it),
+    stepped as FMPy steps it with "file:///", value for value."""
+    job = ["plain 0 3"]
+    for unpacked, lines, _ in fmpy_alone.values():
+        escaped = "".join(f"%{ord(c):02X}" if c == "_" else c for c in str(unpacked))
+        job += [*lines, f"uri {RESOURCE_FORMS[form].format(dir=unpacked, escaped=escaped)}"]
+    (tmp_path / "job.txt").write_text("\n".join(job) + "\n")
+    out = run_host(host, tmp_path / "job.txt")
+    assert out[-1] == "done 0 failures", out[-20:]
+    for name, (_, _, reference) in fmpy_alone.items():
+        assert np.array_equal(table(out, f"{name}:run"), reference), name
+
+
+def test_a_resource_location_that_is_no_local_file_is_refused_by_name(
+    host: Path, tmp_path: Path
+) -> None:
+    path = build_fmu("Inertia")
+    unpacked = unpack(path, tmp_path / "x")
+    job = ["plain 0 1", *fmu_lines("i", path, unpacked, {}, []), "uri http://host/resources"]
+    (tmp_path / "job.txt").write_text("\n".join(job + ["step 1e-3"]) + "\n")
+    out = run_host(host, tmp_path / "job.txt")
+    assert "instantiate i returned NULL" in out
+    assert any(
+        ln.startswith("log Error i:") and '"http://host/resources" is no file URI' in ln
+        for ln in out
+    ), out
+    job[-1] = f"uri file://{tmp_path}/resources"  # an existing directory, not the FMU's
+    (tmp_path / "job.txt").write_text("\n".join(job + ["step 1e-3"]) + "\n")
+    out = run_host(host, tmp_path / "job.txt")
+    assert "instantiate i returned NULL" in out
+    assert any("no slavemodule.txt in" in ln for ln in out), out
+
+
 def test_m739_train_and_verge_coupled_in_a_c_host_match_our_jacobi_master(
     host: Path, tmp_path: Path
 ) -> None:

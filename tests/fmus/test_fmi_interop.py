@@ -292,7 +292,9 @@ def test_invalid_steps_are_refused_with_the_reason_logged(h) -> None:
     try:
         fmu.initialize(0.0, 1.0, {"J": 1.0})
         before = fmu.get_state()
-        with pytest.raises(RunError, match=r"doStep failed: .*refused: .*(not positive|not finite)"):
+        with pytest.raises(
+            RunError, match=r"doStep failed: .*refused: .*(not positive|not finite)"
+        ):
             fmu.do_step(0.0, h)
         with pytest.raises(RunError, match="fmi2SetReal: not allowed in state error"):
             fmu.set_real(fmu.refs(["tau"]), [1.0])
