@@ -89,6 +89,7 @@ class ComponentSlave(Fmi2Slave):
         self.default_experiment = DefaultExperiment(start, stop, step)
         try:
             self.component_class = _component_class(self.component)
+            self._component_error = _component_class("base.ComponentError")
         except ImportError as exc:  # a module the FMU needs is not installed in this Python
             message = (
                 f"{type(self).__name__} cannot load its Python code: {exc}. Install the "
@@ -187,23 +188,50 @@ class ComponentSlave(Fmi2Slave):
         if problem is not None:
             self._refuse(f"fmi2ExitInitializationMode: {problem}")
             return
-        self.model.initialize(self._start_time)
-        self.model.update_outputs()
+        if not self._computed("fmi2ExitInitializationMode", initialize=True):
+            return
         self._initializing = False
         self._initialized = True
         self._init_stale = False
         self._feedthrough_stale = False
         self._t_end = self._start_time
 
-    def _refresh(self) -> None:
+    def _refresh(self, function: str) -> bool:
+        """Bring the outputs up to date with what was set; False if the component cannot
+        (refused, saying why)."""
         if self._initializing:
             if self._init_stale:
-                self.model.initialize(self._start_time)
-                self.model.update_outputs()
+                if not self._computed(function, initialize=True):
+                    return False
                 self._init_stale = False
         elif self._feedthrough_stale:
-            self.model.update_outputs()
+            if not self._computed(function, initialize=False):
+                return False
         self._feedthrough_stale = False
+        return True
+
+    def _computed(self, function: str, initialize: bool) -> bool:
+        """(Re)initialize the component, or only its outputs; a failure is refused with the
+        component's reason, never a Python error text alone."""
+        try:
+            if initialize:
+                self.model.initialize(self._start_time)
+            self.model.update_outputs()
+        except self._component_error as exc:  # the component's own words name what is wrong
+            self._refuse(f"{function}: {exc}")
+            return False
+        except Exception as exc:  # noqa: BLE001 - any failure is the host's to hear, by name
+            zero = [
+                f"{v.name} = {getattr(self.model, v.name)!r}"
+                for v in self.component_class.VARIABLES
+                if v.causality == "input" and getattr(self.model, v.name) == 0
+            ]
+            self._refuse(
+                f"{function}: {type(self).__name__} cannot compute its outputs from the values "
+                f"set ({exc})" + (f"; inputs at zero: {', '.join(zero)}" if zero else "")
+            )
+            return False
+        return True
 
     def do_step(self, current_time: float, step_size: float) -> bool:
         refusal = ""
@@ -221,7 +249,7 @@ class ComponentSlave(Fmi2Slave):
             return True
         try:
             if self._feedthrough_stale and not self.model.STEP_TAKES_INPUTS:
-                self._refresh()
+                self.model.update_outputs()
             self.model.step(current_time, step_size)
             self._feedthrough_stale = False
         except Exception as exc:  # the FMU cannot go on: say why through the FMI logger
@@ -260,8 +288,8 @@ class ComponentSlave(Fmi2Slave):
         if not self._readable["Real"].issuperset(vrs):
             self._bad_reference("fmi2GetReal", "Real", vrs, self._readable["Real"])
             return [0.0] * len(vrs)
-        if self._feedthrough_stale or self._initializing:
-            self._refresh()
+        if (self._feedthrough_stale or self._initializing) and not self._refresh("fmi2GetReal"):
+            return [0.0] * len(vrs)
         comp = self.model
         names = self._names
         return [float(getattr(comp, names[vr])) for vr in vrs]
@@ -270,8 +298,8 @@ class ComponentSlave(Fmi2Slave):
         if not self._readable["Integer"].issuperset(vrs):
             self._bad_reference("fmi2GetInteger", "Integer", vrs, self._readable["Integer"])
             return [0] * len(vrs)
-        if self._feedthrough_stale or self._initializing:
-            self._refresh()
+        if (self._feedthrough_stale or self._initializing) and not self._refresh("fmi2GetInteger"):
+            return [0] * len(vrs)
         comp = self.model
         names = self._names
         return [int(getattr(comp, names[vr])) for vr in vrs]
