@@ -33,7 +33,6 @@ import math
 import os
 import sys
 import threading
-import traceback
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, ClassVar
 
@@ -252,9 +251,17 @@ class ComponentSlave(Fmi2Slave):
                 self.model.update_outputs()
             self.model.step(current_time, step_size)
             self._feedthrough_stale = False
-        except Exception as exc:  # the FMU cannot go on: say why through the FMI logger
+        except Exception as exc:  # noqa: BLE001 - the step cannot be completed: say why
+            # fmi2Discard; nothing of the step is kept, so the last successful time is its
+            # start, which pythonfmu's runtime answers to fmi2GetRealStatus
+            why = (
+                str(exc)
+                if isinstance(exc, self._component_error)
+                else f"{type(exc).__name__}: {exc}"
+            )
             self.log(
-                f"{type(exc).__name__}: {exc}\n{traceback.format_exc(limit=3)}", Fmi2Status.error
+                f"fmi2DoStep from t = {current_time!r} s over {step_size!r} s: {why}",
+                Fmi2Status.error,
             )
             return False
         # a component that ends its step at its first event says where (components.early_return)
