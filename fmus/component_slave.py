@@ -12,13 +12,19 @@ instance is made, so that a missing module is reported through the FMU's logger.
 
 FMI calls defend themselves.  pythonfmu's runtime (0.7) turns an exception raised in
 Python into fmi2Fatal, after which the instance cannot be used (a later call may crash the
-host), and a ``do_step`` that returns False into fmi2Discard.  So a step of non-positive
-or non-finite size, from a non-finite time, or with a non-finite Real set on the FMU since
-the last step, is refused with fmi2Discard and nothing changes: the instance stays usable.
-Non-finite parameters fail initialization.  The reason goes to the FMU's log, which the
-FMU's loader (``fmus.host_loader``) passes to the host at any logging setting (pythonfmu's
-runtime alone, in a build without the loader, only with debug logging on); a missing
-module, which ends instantiation before any logging, is also written to standard error.
+host), and a ``do_step`` that returns False into fmi2Discard.  So a call that cannot be
+accepted (a value reference that is unknown or of another type, a fixed parameter after
+initialization, a non-finite value, a step that is not positive or does not start where
+the last ended, another FMU's state, parameters or inputs the component cannot start from)
+is not raised: the reason is logged with fmi2Error and the call returns with nothing
+changed.  The FMU's loader (``fmus/loader/python_loader.c``) answers such a call with
+fmi2Error and keeps FMI 2.0's state machine, which the calls pythonfmu's runtime answers by
+itself (and the order of calls) need; without the loader the refusal is only logged.  A
+step the component cannot complete (its step budget spent, say) is fmi2Discard with the
+component's reason.  The FMU's log reaches the host at any logging setting through the
+loader (pythonfmu's runtime alone, in a build without the loader, only with debug logging
+on); a missing module, which ends instantiation before any logging, is also written to
+standard error.
 
 The runtime also corrupts the heap when a process exits with its library still loaded
 (see ``release_runtime_at_exit``); each instance arranges the remedy.

@@ -344,7 +344,30 @@ static void library_beside(const char* base_bin, int major, int minor, char* lib
 static int check_version(PythonChoice* choice, char* why) {
     char base_bin[PATH_MAX];
     int major, minor;
+    if (access(choice->executable, X_OK) != 0) {
+        snprintf(why, WHY_SIZE, "the Python executable %s (from %s) is not there or not "
+                 "executable; set %s to a Python %d.%d executable", choice->executable,
+                 choice->source, PYTHON_VARIABLE, PY_MAJOR_VERSION, PY_MINOR_VERSION);
+        return 0;
+    }
     inspect_executable(choice->executable, base_bin, &major, &minor);
+    if (major == 0) {
+        /* neither its name nor a pyvenv.cfg tells: its installation's standard library does */
+        char stdlib[PATH_MAX + 64], real[PATH_MAX] = "";
+        snprintf(stdlib, sizeof stdlib, "%s/../lib/python%d.%d/os.py", base_bin,
+                 PY_MAJOR_VERSION, PY_MINOR_VERSION);
+        const char* name = realpath(choice->executable, real) ? strrchr(real, '/') : NULL;
+        if (name == NULL || strncmp(name + 1, "python", 6) != 0 || access(stdlib, R_OK) != 0) {
+            snprintf(why, WHY_SIZE,
+                     "%s (from %s) is not a Python %d.%d executable (not named python%d.%d, "
+                     "no pyvenv.cfg beside it, or no lib/python%d.%d/os.py in its "
+                     "installation); set %s to a Python %d.%d executable",
+                     choice->executable, choice->source, PY_MAJOR_VERSION, PY_MINOR_VERSION,
+                     PY_MAJOR_VERSION, PY_MINOR_VERSION, PY_MAJOR_VERSION, PY_MINOR_VERSION,
+                     PYTHON_VARIABLE, PY_MAJOR_VERSION, PY_MINOR_VERSION);
+            return 0;
+        }
+    }
     if (major != 0 && (major != PY_MAJOR_VERSION || minor != PY_MINOR_VERSION)) {
         snprintf(why, WHY_SIZE,
                  "the FMU was built for Python %d.%d, but %s (from %s) is Python %d.%d; set "

@@ -340,6 +340,25 @@ def test_a_python_named_by_the_variable_is_started_and_its_environment_used(
     ), out
 
 
+@pytest.mark.parametrize("what", ["ls", "a text file"])
+def test_a_variable_naming_no_python_is_refused_at_instantiation(
+    host: Path, tmp_path: Path, what: str
+) -> None:
+    """Something that is not a Python executable is not started as one: fmi2Instantiate
+    returns NULL with the reason (/bin/ls beside /usr/lib/python3.X would start, badly)."""
+    path = build_fmu("Inertia")
+    job = ["plain 0 1", *fmu_lines("i", path, unpack(path, tmp_path / "x"), {}, []), "step 1e-3"]
+    (tmp_path / "job.txt").write_text("\n".join(job) + "\n")
+    named = shutil.which("ls") if what == "ls" else str(tmp_path / "job.txt")
+    out = run_host(host, tmp_path / "job.txt", {"MECHCOSIM_PYTHON": named})
+    assert "instantiate i returned NULL" in out
+    version = f"{sys.version_info.major}.{sys.version_info.minor}"
+    expected = "is not a Python" if what == "ls" else "is not there or not executable"
+    logged = [ln for ln in out if ln.startswith("log Error i:")]
+    assert logged and named in logged[0] and expected in logged[0], out
+    assert f"set MECHCOSIM_PYTHON to a Python {version} executable" in logged[0], out
+
+
 def test_without_a_c_compiler_the_build_says_so_and_the_fmu_runs_in_python_hosts(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture
 ) -> None:
