@@ -125,37 +125,88 @@ static const char* const PHASE_NAMES[N_PHASES] = {
  * loader calls the runtime's.  The forwarded ones change no state themselves; the
  * loader's own wrappers (below) move the instance from state to state. */
 #define FORWARDED_FUNCTIONS(X)                                                                  \
-    X(fmi2SetupExperiment, IN(INSTANTIATED), (fmi2Component c, fmi2Boolean toleranceDefined, fmi2Real tolerance, fmi2Real startTime, fmi2Boolean stopTimeDefined, fmi2Real stopTime), (i->inner, toleranceDefined, tolerance, startTime, stopTimeDefined, stopTime)) \
-    X(fmi2GetReal, READABLE, (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Real v[]), (i->inner, vr, nvr, v)) \
-    X(fmi2GetInteger, READABLE, (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Integer v[]), (i->inner, vr, nvr, v)) \
-    X(fmi2GetBoolean, READABLE, (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Boolean v[]), (i->inner, vr, nvr, v)) \
-    X(fmi2GetString, READABLE, (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2String v[]), (i->inner, vr, nvr, v)) \
-    X(fmi2SetReal, SETTABLE, (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Real v[]), (i->inner, vr, nvr, v)) \
-    X(fmi2SetInteger, SETTABLE, (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Integer v[]), (i->inner, vr, nvr, v)) \
-    X(fmi2SetBoolean, SETTABLE, (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Boolean v[]), (i->inner, vr, nvr, v)) \
-    X(fmi2SetString, SETTABLE, (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2String v[]), (i->inner, vr, nvr, v)) \
-    X(fmi2GetDirectionalDerivative, READABLE, (fmi2Component c, const fmi2ValueReference unknown[], size_t n_unknown, const fmi2ValueReference known[], size_t n_known, const fmi2Real dv_known[], fmi2Real dv_unknown[]), (i->inner, unknown, n_unknown, known, n_known, dv_known, dv_unknown)) \
-    X(fmi2SetRealInputDerivatives, SETTABLE, (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Integer order[], const fmi2Real v[]), (i->inner, vr, nvr, order, v)) \
-    X(fmi2GetRealOutputDerivatives, IN(STEP_COMPLETE) | IN(STEP_FAILED) | IN(STEP_CANCELED) | IN(TERMINATED) | IN(ERROR_STATE), (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Integer order[], fmi2Real v[]), (i->inner, vr, nvr, order, v)) \
+    X(fmi2SetupExperiment, IN(INSTANTIATED),                                                    \
+      (fmi2Component c, fmi2Boolean toleranceDefined, fmi2Real tolerance, fmi2Real startTime,   \
+       fmi2Boolean stopTimeDefined, fmi2Real stopTime),                                         \
+      (i->inner, toleranceDefined, tolerance, startTime, stopTimeDefined, stopTime))            \
+    X(fmi2GetReal, READABLE,                                                                    \
+      (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Real v[]),               \
+      (i->inner, vr, nvr, v))                                                                   \
+    X(fmi2GetInteger, READABLE,                                                                 \
+      (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Integer v[]),            \
+      (i->inner, vr, nvr, v))                                                                   \
+    X(fmi2GetBoolean, READABLE,                                                                 \
+      (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Boolean v[]),            \
+      (i->inner, vr, nvr, v))                                                                   \
+    X(fmi2GetString, READABLE,                                                                  \
+      (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2String v[]),             \
+      (i->inner, vr, nvr, v))                                                                   \
+    X(fmi2SetReal, SETTABLE,                                                                    \
+      (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Real v[]),         \
+      (i->inner, vr, nvr, v))                                                                   \
+    X(fmi2SetInteger, SETTABLE,                                                                 \
+      (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Integer v[]),      \
+      (i->inner, vr, nvr, v))                                                                   \
+    X(fmi2SetBoolean, SETTABLE,                                                                 \
+      (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Boolean v[]),      \
+      (i->inner, vr, nvr, v))                                                                   \
+    X(fmi2SetString, SETTABLE,                                                                  \
+      (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2String v[]),       \
+      (i->inner, vr, nvr, v))                                                                   \
+    X(fmi2GetDirectionalDerivative, READABLE,                                                   \
+      (fmi2Component c, const fmi2ValueReference unknown[], size_t n_unknown,                   \
+       const fmi2ValueReference known[], size_t n_known, const fmi2Real dv_known[],             \
+       fmi2Real dv_unknown[]),                                                                  \
+      (i->inner, unknown, n_unknown, known, n_known, dv_known, dv_unknown))                     \
+    X(fmi2SetRealInputDerivatives, SETTABLE,                                                    \
+      (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Integer order[],   \
+       const fmi2Real v[]),                                                                     \
+      (i->inner, vr, nvr, order, v))                                                            \
+    X(fmi2GetRealOutputDerivatives, AFTER_STEPS | IN(ERROR_STATE),                             \
+      (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Integer order[],   \
+       fmi2Real v[]),                                                                           \
+      (i->inner, vr, nvr, order, v))                                                            \
     X(fmi2CancelStep, IN(STEP_IN_PROGRESS), (fmi2Component c), (i->inner))                      \
-    X(fmi2GetStatus, AFTER_STEPS, (fmi2Component c, const fmi2StatusKind s, fmi2Status * v), (i->inner, s, v)) \
-    X(fmi2GetRealStatus, AFTER_STEPS, (fmi2Component c, const fmi2StatusKind s, fmi2Real * v), (i->inner, s, v)) \
-    X(fmi2GetIntegerStatus, AFTER_STEPS, (fmi2Component c, const fmi2StatusKind s, fmi2Integer * v), (i->inner, s, v)) \
-    X(fmi2GetBooleanStatus, AFTER_STEPS, (fmi2Component c, const fmi2StatusKind s, fmi2Boolean * v), (i->inner, s, v)) \
-    X(fmi2GetStringStatus, AFTER_STEPS, (fmi2Component c, const fmi2StatusKind s, fmi2String * v), (i->inner, s, v))
+    X(fmi2GetStatus, AFTER_STEPS,                                                               \
+      (fmi2Component c, const fmi2StatusKind s, fmi2Status * v),                                \
+      (i->inner, s, v))                                                                         \
+    X(fmi2GetRealStatus, AFTER_STEPS,                                                           \
+      (fmi2Component c, const fmi2StatusKind s, fmi2Real * v),                                  \
+      (i->inner, s, v))                                                                         \
+    X(fmi2GetIntegerStatus, AFTER_STEPS,                                                        \
+      (fmi2Component c, const fmi2StatusKind s, fmi2Integer * v),                               \
+      (i->inner, s, v))                                                                         \
+    X(fmi2GetBooleanStatus, AFTER_STEPS,                                                        \
+      (fmi2Component c, const fmi2StatusKind s, fmi2Boolean * v),                               \
+      (i->inner, s, v))                                                                         \
+    X(fmi2GetStringStatus, AFTER_STEPS,                                                         \
+      (fmi2Component c, const fmi2StatusKind s, fmi2String * v),                                \
+      (i->inner, s, v))
 
 #define OWN_FUNCTIONS(X)                                                                        \
     X(fmi2EnterInitializationMode, IN(INSTANTIATED), (fmi2Component c), (i->inner))             \
     X(fmi2ExitInitializationMode, IN(INITIALIZATION_MODE), (fmi2Component c), (i->inner))       \
-    X(fmi2Terminate, IN(STEP_COMPLETE) | IN(STEP_FAILED) | IN(STEP_CANCELED), (fmi2Component c), (i->inner)) \
+    X(fmi2Terminate, IN(STEP_COMPLETE) | IN(STEP_FAILED) | IN(STEP_CANCELED),                   \
+      (fmi2Component c),                                                                        \
+      (i->inner))                                                                               \
     X(fmi2Reset, ANY_BUT_FATAL, (fmi2Component c), (i->inner))                                  \
     X(fmi2GetFMUstate, ANY_BUT_FATAL, (fmi2Component c, fmi2FMUstate * state), (i->inner, state)) \
     X(fmi2SetFMUstate, ANY_BUT_FATAL, (fmi2Component c, fmi2FMUstate state), (i->inner, state)) \
     X(fmi2FreeFMUstate, ANY_BUT_FATAL, (fmi2Component c, fmi2FMUstate * state), (i->inner, state)) \
-    X(fmi2SerializedFMUstateSize, ANY_BUT_FATAL, (fmi2Component c, fmi2FMUstate state, size_t * size), (i->inner, state, size)) \
-    X(fmi2SerializeFMUstate, ANY_BUT_FATAL, (fmi2Component c, fmi2FMUstate state, fmi2Byte bytes[], size_t size), (i->inner, state, bytes, size)) \
-    X(fmi2DeSerializeFMUstate, ANY_BUT_FATAL, (fmi2Component c, const fmi2Byte bytes[], size_t size, fmi2FMUstate * state), (i->inner, bytes, size, state)) \
-    X(fmi2DoStep, IN(STEP_COMPLETE), (fmi2Component c, fmi2Real currentCommunicationPoint, fmi2Real communicationStepSize, fmi2Boolean noSetFMUStatePriorToCurrentCommunicationPoint), (i->inner, currentCommunicationPoint, communicationStepSize, noSetFMUStatePriorToCurrentCommunicationPoint))
+    X(fmi2SerializedFMUstateSize, ANY_BUT_FATAL,                                                \
+      (fmi2Component c, fmi2FMUstate state, size_t * size),                                     \
+      (i->inner, state, size))                                                                  \
+    X(fmi2SerializeFMUstate, ANY_BUT_FATAL,                                                     \
+      (fmi2Component c, fmi2FMUstate state, fmi2Byte bytes[], size_t size),                     \
+      (i->inner, state, bytes, size))                                                           \
+    X(fmi2DeSerializeFMUstate, ANY_BUT_FATAL,                                                   \
+      (fmi2Component c, const fmi2Byte bytes[], size_t size, fmi2FMUstate * state),             \
+      (i->inner, bytes, size, state))                                                           \
+    X(fmi2DoStep, IN(STEP_COMPLETE),                                                            \
+      (fmi2Component c, fmi2Real currentCommunicationPoint, fmi2Real communicationStepSize,     \
+       fmi2Boolean noSetFMUStatePriorToCurrentCommunicationPoint),                              \
+      (i->inner, currentCommunicationPoint, communicationStepSize,                              \
+       noSetFMUStatePriorToCurrentCommunicationPoint))
 
 #define INSTANCE_FUNCTIONS(X) FORWARDED_FUNCTIONS(X) OWN_FUNCTIONS(X)
 
@@ -929,7 +980,8 @@ EXPORT fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate state
     SavedState* saved = own_state(i, "fmi2SerializedFMUstateSize", state);
     if (saved == NULL) return fmi2Error;
     size_t inner = 0;
-    fmi2Status status = settle(i, runtime.fmi2SerializedFMUstateSize(i->inner, saved->inner, &inner));
+    fmi2Status status =
+        settle(i, runtime.fmi2SerializedFMUstateSize(i->inner, saved->inner, &inner));
     if (status == fmi2OK && size) *size = inner + STATE_HEADER;
     return status;
 }

@@ -196,6 +196,9 @@ def drive(name: str, path: Path, scratch: Path) -> Driven:
         fmu.setupExperiment(startTime=0.0)
         fmu.enterInitializationMode()
         fmu.setInteger([budget.valueReference], [1])
+        moving = variables.get("phi_dot")  # a wheel at rest would take the step at once
+        if moving is not None and moving.causality == "input":
+            fmu.setReal([moving.valueReference], [50.0])
         fmu.exitInitializationMode()
         try:
             fmu.doStep(0.0, 1e6)
