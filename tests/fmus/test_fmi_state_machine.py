@@ -158,9 +158,9 @@ print("fuzz done")
 def test_random_call_sequences_answer_as_the_state_machine(tmp_path: Path) -> None:
     script = FUZZ.format(
         tests=str(Path(__file__).parent),
-        names=["Inertia", "GearTrain", "VergeEscapement", "SpragClutch"],
+        names=["Inertia", "GearTrain", "VergeEscapement"],
         scratch=str(tmp_path),
-        examples=60,
+        examples=40,
     )
     run = subprocess.run(
         [sys.executable, "-c", textwrap.dedent(script)],
