@@ -51,6 +51,8 @@ class IntegrationStepControl:
     rtol: float
     scales: tuple[float, ...]
     h_max: float = math.inf
+    #: budget of one ``advance``: integration steps, accepted and rejected (None: unbounded)
+    max_steps: int | None = None
 
     def __post_init__(self) -> None:
         if not (0.0 < self.rtol < 1.0):
@@ -81,21 +83,46 @@ INTEGRATION_VARIABLES = (
 )
 
 
-def integration_variables(h_max: float) -> tuple[Variable, Variable]:
+#: Internal steps one doStep may take by default: far beyond any example scene's, about
+#: 5 to 10 s of work; a doStep that needs more ends with a message instead of running on.
+DEFAULT_STEP_BUDGET = 100_000
+
+#: The FMU parameter that bounds the work of one doStep (the components integrated here
+#: declare it with their INTEGRATION_VARIABLES or through ``TrainComponent``).
+STEP_BUDGET_VARIABLE = Variable(
+    "max_internal_steps",
+    "parameter",
+    "1",
+    DEFAULT_STEP_BUDGET,
+    "budget of one doStep in internal integration steps, accepted and rejected (spent: "
+    "the step is discarded, with a message)",
+    "Integer",
+    min=1.0,
+)
+
+
+class StepBudgetSpent(ComponentError):
+    """One ``advance`` took more internal steps than its control's ``max_steps``."""
+
+
+def integration_variables(h_max: float) -> tuple[Variable, ...]:
     """INTEGRATION_VARIABLES with another default largest step (a model whose indicators
-    change slowly need not cap its steps at 0.1 ms)."""
+    change slowly need not cap its steps at 0.1 ms), and the step budget."""
     tolerance, largest = INTEGRATION_VARIABLES
-    return tolerance, replace(largest, start=h_max)
+    return tolerance, replace(largest, start=h_max), STEP_BUDGET_VARIABLE
 
 
 def integration_step_control(
     component: object, scales: tuple[float, ...]
 ) -> IntegrationStepControl:
-    """The IntegrationStepControl of a component from its INTEGRATION_VARIABLES."""
+    """The IntegrationStepControl of a component from its INTEGRATION_VARIABLES (and its
+    ``max_internal_steps``, where it has one)."""
+    budget = getattr(component, "max_internal_steps", None)
     return IntegrationStepControl(
         float(component.tolerance),  # type: ignore[attr-defined]
         scales,
         float(component.h_max),  # type: ignore[attr-defined]
+        None if budget is None else int(budget),
     )
 
 
@@ -383,7 +410,14 @@ def advance(
     h = h_try if h_try > 0.0 else _first_step(y, k1, control)
     h_next = h
     h_min = max(_H_MIN_ABSOLUTE, _H_MIN_RELATIVE * h_total)
+    budget = control.max_steps
     while t < end:
+        if budget is not None and steps + rejected >= budget:
+            raise StepBudgetSpent(
+                f"spent its budget of {budget} internal steps (max_internal_steps) "
+                f"{t:.6g} s into a step of {h_total:.6g} s; take shorter communication "
+                "steps or give a larger budget"
+            )
         left = h_total - t
         if t > 0.0 and left <= h_min:  # an event left a sliver below the time resolution
             break

@@ -10,7 +10,7 @@ from typing import Any
 from .augmented_model import AugmentedModel
 from .base import Component, SnapshotPlan
 from .early_return import UntilFirstEvent, reached
-from .event_integration import advance, integration_step_control
+from .event_integration import STEP_BUDGET_VARIABLE, advance, integration_step_control
 
 #: Magnitudes below which the integration controls the state [phi, phi_d, W] absolutely:
 #: rad, rad/s, J.
@@ -120,6 +120,14 @@ class TrainComponent(Component):
     """
 
     STEP_TAKES_INPUTS = True  # step() starts with _apply_inputs and ends with _outputs
+
+    def __init_subclass__(cls, **kwargs: object) -> None:
+        super().__init_subclass__(**kwargs)
+        # Every train integrates with event_integration.advance: each bounds the work of
+        # one doStep by the same parameter, declared here once for all of them.
+        if not any(v.name == STEP_BUDGET_VARIABLE.name for v in cls.VARIABLES):
+            cls.VARIABLES = (*cls.VARIABLES, STEP_BUDGET_VARIABLE)
+
     _PHYSICS: type
     _MODEL: type
     # The snapshot copies the mutable mode and state; the constants (and the memo of

@@ -1069,6 +1069,16 @@ class VergeEscapement(Component):
 
     def initialize(self, t0: float) -> None:
         self.check_parameters()  # a NaN spin or restitution is named here, not met later
+        # The train's inertias divide the wheel's motion: a host that starts every input
+        # at 0 must be told which, not meet a division by zero.
+        for name in ("J_ref", "J_stot"):
+            value = getattr(self, name)
+            if not value > 0.0:
+                raise ComponentError(
+                    f"VergeEscapement: input {name} = {value!r} kg.m2 at initialization; "
+                    "expected more than 0 (an inertia of the train at the escape wheel: set it "
+                    "from the train's output before initialization ends)"
+                )
         self._control = integration_step_control(self, STATE_SCALES)
         self._h_next = 0.0
         data = design_of(self, VERGE)

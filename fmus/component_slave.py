@@ -12,13 +12,19 @@ instance is made, so that a missing module is reported through the FMU's logger.
 
 FMI calls defend themselves.  pythonfmu's runtime (0.7) turns an exception raised in
 Python into fmi2Fatal, after which the instance cannot be used (a later call may crash the
-host), and a ``do_step`` that returns False into fmi2Discard.  So a step of non-positive
-or non-finite size, from a non-finite time, or with a non-finite Real set on the FMU since
-the last step, is refused with fmi2Discard and nothing changes: the instance stays usable.
-Non-finite parameters fail initialization.  The reason goes to the FMU's log, which the
-FMU's loader (``fmus.host_loader``) passes to the host at any logging setting (pythonfmu's
-runtime alone, in a build without the loader, only with debug logging on); a missing
-module, which ends instantiation before any logging, is also written to standard error.
+host), and a ``do_step`` that returns False into fmi2Discard.  So a call that cannot be
+accepted (a value reference that is unknown or of another type, a fixed parameter after
+initialization, a non-finite value, a step that is not positive or does not start where
+the last ended, another FMU's state, parameters or inputs the component cannot start from)
+is not raised: the reason is logged with fmi2Error and the call returns with nothing
+changed.  The FMU's loader (``fmus/loader/python_loader.c``) answers such a call with
+fmi2Error and keeps FMI 2.0's state machine, which the calls pythonfmu's runtime answers by
+itself (and the order of calls) need; without the loader the refusal is only logged.  A
+step the component cannot complete (its step budget spent, say) is fmi2Discard with the
+component's reason.  The FMU's log reaches the host at any logging setting through the
+loader (pythonfmu's runtime alone, in a build without the loader, only with debug logging
+on); a missing module, which ends instantiation before any logging, is also written to
+standard error.
 
 The runtime also corrupts the heap when a process exits with its library still loaded
 (see ``release_runtime_at_exit``); each instance arranges the remedy.
@@ -33,7 +39,6 @@ import math
 import os
 import sys
 import threading
-import traceback
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, ClassVar
 
@@ -89,6 +94,7 @@ class ComponentSlave(Fmi2Slave):
         self.default_experiment = DefaultExperiment(start, stop, step)
         try:
             self.component_class = _component_class(self.component)
+            self._component_error = _component_class("base.ComponentError")
         except ImportError as exc:  # a module the FMU needs is not installed in this Python
             message = (
                 f"{type(self).__name__} cannot load its Python code: {exc}. Install the "
@@ -100,14 +106,29 @@ class ComponentSlave(Fmi2Slave):
             raise
         self.model = self.component_class()
         self._names: list[str] = []
+        self._types: list[str] = []
+        self._causalities: list[str] = []
         self._inputs: set[int] = set()
         self._feedthrough_stale = False
         self._initializing = False
+        self._initialized = False  # initialization mode left: fixed parameters are fixed
         self._init_stale = False
         self._start_time = 0.0
-        self._not_finite: set[str] = set()  # Reals whose last value set is NaN or inf
+        self._t_end = 0.0  # where the last step ended: the next one starts there
+        self._last_h = 0.0
         for var in self.component_class.VARIABLES:
             self._register(var)
+        reals = {vr for vr, kind in enumerate(self._types) if kind == "Real"}
+        integers = set(range(len(self._types))) - reals
+        settable = {vr for vr, c in enumerate(self._causalities) if c in ("parameter", "input")}
+        self._readable = {"Real": frozenset(reals), "Integer": frozenset(integers)}
+        self._settable_before = {
+            "Real": frozenset(reals & settable),
+            "Integer": frozenset(integers & settable),
+        }
+        self._settable_after = {
+            kind: frozenset(vrs & self._inputs) for kind, vrs in self._settable_before.items()
+        }
 
     def _register(self, var: Any) -> None:
         comp = self.model
@@ -132,15 +153,20 @@ class ComponentSlave(Fmi2Slave):
         if var.causality == "input":
             self._inputs.add(fmi_var.value_reference)
         self._names.append(name)
+        self._types.append("Integer" if var.type == "Integer" else "Real")
+        self._causalities.append(var.causality)
 
     # -- life cycle -------------------------------------------------------------------
     # Outputs must be valid in initialization mode too (a master reads them there to set
     # consistent inputs), so the component is (re)initialized from the current parameters
     # whenever something was set and an output is read, and once more on leaving the mode.
+    # Which call is allowed when is the FMU's loader's to check (fmus/loader/python_loader.c);
+    # what needs the variables (types, fixed parameters, times) is checked here.
     def setup_experiment(self, start_time: float, stop_time: float | None, tolerance: float | None):
         if not math.isfinite(start_time):
-            raise self._refuse(f"setupExperiment: start time {start_time} is not finite")
-        self._start_time = float(start_time)
+            self._refuse(f"fmi2SetupExperiment: start time {start_time} is not finite")
+            return
+        self._start_time = self._t_end = float(start_time)
         # A tolerance the host defines is the internal integration's (FMI 2.0, 4.2.4), within
         # the parameter's range; a value the host then sets for `tolerance` still wins.
         declared = next((v for v in self.component_class.VARIABLES if v.name == "tolerance"), None)
@@ -161,102 +187,212 @@ class ComponentSlave(Fmi2Slave):
             if v.type == "Real" and not math.isfinite(getattr(self.model, v.name))
         ]
         if bad:
-            raise self._refuse(f"initialization: not finite: {', '.join(bad)}")
+            self._refuse(f"fmi2ExitInitializationMode: not finite: {', '.join(bad)}")
+            return
         problem = self.model.parameter_problem()
         if problem is not None:
-            raise self._refuse(f"initialization: {problem}")
-        self._not_finite.clear()
-        self.model.initialize(self._start_time)
-        self.model.update_outputs()
+            self._refuse(f"fmi2ExitInitializationMode: {problem}")
+            return
+        if not self._computed("fmi2ExitInitializationMode", initialize=True):
+            return
         self._initializing = False
+        self._initialized = True
         self._init_stale = False
         self._feedthrough_stale = False
+        self._t_end = self._start_time
 
-    def _refresh(self) -> None:
+    def _refresh(self, function: str) -> bool:
+        """Bring the outputs up to date with what was set; False if the component cannot
+        (refused, saying why)."""
         if self._initializing:
             if self._init_stale:
-                self.model.initialize(self._start_time)
-                self.model.update_outputs()
+                if not self._computed(function, initialize=True):
+                    return False
                 self._init_stale = False
         elif self._feedthrough_stale:
-            self.model.update_outputs()
+            if not self._computed(function, initialize=False):
+                return False
         self._feedthrough_stale = False
+        return True
 
-    def do_step(self, current_time: float, step_size: float) -> bool:
-        refusal = ""
-        if not (math.isfinite(current_time) and math.isfinite(current_time + step_size)):
-            refusal = f"time {current_time} or step size {step_size} is not finite"
-        elif not step_size > 0.0:
-            refusal = f"step size {step_size} is not positive"
-        elif self._not_finite:
-            refusal = f"values set are not finite: {', '.join(sorted(self._not_finite))}"
-        if refusal:  # fmi2Discard, nothing changed: the instance stays usable
-            self._refuse(f"doStep at t = {current_time} refused: {refusal}")
-            return False
+    def _computed(self, function: str, initialize: bool) -> bool:
+        """(Re)initialize the component, or only its outputs; a failure is refused with the
+        component's reason, never a Python error text alone."""
         try:
-            if self._feedthrough_stale and not self.model.STEP_TAKES_INPUTS:
-                self._refresh()
-            self.model.step(current_time, step_size)
-            self._feedthrough_stale = False
-        except Exception as exc:  # the FMU cannot go on: say why through the FMI logger
-            self.log(
-                f"{type(exc).__name__}: {exc}\n{traceback.format_exc(limit=3)}", Fmi2Status.error
+            if initialize:
+                self.model.initialize(self._start_time)
+            self.model.update_outputs()
+        except self._component_error as exc:  # the component's own words name what is wrong
+            self._refuse(f"{function}: {exc}")
+            return False
+        except Exception as exc:  # noqa: BLE001 - any failure is the host's to hear, by name
+            zero = [
+                f"{v.name} = {getattr(self.model, v.name)!r}"
+                for v in self.component_class.VARIABLES
+                if v.causality == "input" and getattr(self.model, v.name) == 0
+            ]
+            self._refuse(
+                f"{function}: {type(self).__name__} cannot compute its outputs from the values "
+                f"set ({exc})" + (f"; inputs at zero: {', '.join(zero)}" if zero else "")
             )
             return False
         return True
 
-    def _refuse(self, message: str) -> FmiCallError:
-        """Log why a call is refused; the result is for the caller to raise, if it must."""
-        self.log(message, Fmi2Status.error)
-        return FmiCallError(message)
+    def do_step(self, current_time: float, step_size: float) -> bool:
+        refusal = ""
+        expected = self._t_end
+        if not (math.isfinite(current_time) and math.isfinite(current_time + step_size)):
+            refusal = f"time {current_time} or step size {step_size} is not finite"
+        elif not step_size > 0.0:
+            refusal = f"step size {step_size} is not positive"
+        elif abs(current_time - expected) > TIME_MATCH * max(
+            abs(expected), abs(current_time), self._last_h
+        ):
+            refusal = f"the last step ended at t = {expected!r} s, where the next must start"
+        if refusal:  # fmi2Error, nothing changed
+            self._refuse(f"fmi2DoStep at t = {current_time!r} s refused: {refusal}")
+            return True
+        try:
+            if self._feedthrough_stale and not self.model.STEP_TAKES_INPUTS:
+                self.model.update_outputs()
+            self.model.step(current_time, step_size)
+            self._feedthrough_stale = False
+        except Exception as exc:  # noqa: BLE001 - the step cannot be completed: say why
+            # fmi2Discard; nothing of the step is kept, so the last successful time is its
+            # start, which pythonfmu's runtime answers to fmi2GetRealStatus
+            why = (
+                str(exc)
+                if isinstance(exc, self._component_error)
+                else f"{type(exc).__name__}: {exc}"
+            )
+            self.log(
+                f"fmi2DoStep from t = {current_time!r} s over {step_size!r} s: {why}",
+                Fmi2Status.error,
+            )
+            return False
+        # a component that ends its step at its first event says where (components.early_return)
+        self._t_end = float(getattr(self.model, "t_reached", current_time + step_size))
+        self._last_h = step_size
+        return True
 
-    # -- lean variable access (the hot path of every master step) ----------------------
+    def _refuse(self, message: str) -> None:
+        """Refuse the call: log why with fmi2Error, which the FMU's loader answers with."""
+        self.log(message, Fmi2Status.error)
+
+    # -- variable access (the hot path of every master step) ---------------------------
+    def _bad_reference(self, function: str, kind: str, vrs: list[int], allowed: frozenset) -> None:
+        """Refuse a call with a value reference that is not in ``allowed``, saying why."""
+        vr = next(vr for vr in vrs if vr not in allowed)
+        if not 0 <= vr < len(self._names):
+            self._refuse(f"{function}: no variable has value reference {vr}")
+            return
+        name, its = self._names[vr], self._types[vr]
+        if its != kind:
+            article = "an" if its[0] in "AEIOU" else "a"
+            self._refuse(f"{function}: value reference {vr} is {name}, {article} {its}")
+        elif self._causalities[vr] == "output":
+            self._refuse(f"{function}: {name} is an output, which the host cannot set")
+        else:
+            self._refuse(
+                f"{function}: {name} is a fixed parameter, which cannot change after initialization"
+            )
+
     def get_real(self, vrs: list[int]) -> list[float]:
-        if self._feedthrough_stale or self._initializing:
-            self._refresh()
+        if not self._readable["Real"].issuperset(vrs):
+            self._bad_reference("fmi2GetReal", "Real", vrs, self._readable["Real"])
+            return [0.0] * len(vrs)
+        if (self._feedthrough_stale or self._initializing) and not self._refresh("fmi2GetReal"):
+            return [0.0] * len(vrs)
         comp = self.model
         names = self._names
         return [float(getattr(comp, names[vr])) for vr in vrs]
 
     def get_integer(self, vrs: list[int]) -> list[int]:
-        if self._feedthrough_stale or self._initializing:
-            self._refresh()
+        if not self._readable["Integer"].issuperset(vrs):
+            self._bad_reference("fmi2GetInteger", "Integer", vrs, self._readable["Integer"])
+            return [0] * len(vrs)
+        if (self._feedthrough_stale or self._initializing) and not self._refresh("fmi2GetInteger"):
+            return [0] * len(vrs)
         comp = self.model
         names = self._names
         return [int(getattr(comp, names[vr])) for vr in vrs]
 
     def set_real(self, vrs: list[int], values: list[float]) -> None:
+        settable = (self._settable_after if self._initialized else self._settable_before)["Real"]
+        if not settable.issuperset(vrs):
+            self._bad_reference("fmi2SetReal", "Real", vrs, settable)
+            return
+        if not all(map(math.isfinite, values)):
+            vr, value = next(
+                (r, v) for r, v in zip(vrs, values, strict=True) if not math.isfinite(v)
+            )
+            self._refuse(f"fmi2SetReal: {self._names[vr]} = {value} is not finite")
+            return
         comp = self.model
         names = self._names
-        if not all(map(math.isfinite, values)) or self._not_finite:
-            # Refused at the next step (see do_step), until set to finite values again.
-            for vr, value in zip(vrs, values, strict=True):
-                (self._not_finite.discard if math.isfinite(value) else self._not_finite.add)(
-                    names[vr]
-                )
         for vr, value in zip(vrs, values, strict=True):
             setattr(comp, names[vr], float(value))
         self._feedthrough_stale = self._init_stale = True
 
     def set_integer(self, vrs: list[int], values: list[int]) -> None:
+        settable = (self._settable_after if self._initialized else self._settable_before)["Integer"]
+        if not settable.issuperset(vrs):
+            self._bad_reference("fmi2SetInteger", "Integer", vrs, settable)
+            return
         comp = self.model
         names = self._names
         for vr, value in zip(vrs, values, strict=True):
             setattr(comp, names[vr], int(value))
         self._feedthrough_stale = self._init_stale = True
 
+    # no Boolean or String variables: an empty call is answered, any reference refused
+    def get_boolean(self, vrs: list[int]) -> list[bool]:
+        if vrs:
+            self._bad_reference("fmi2GetBoolean", "Boolean", vrs, frozenset())
+        return [False] * len(vrs)
+
+    def get_string(self, vrs: list[int]) -> list[str]:
+        if vrs:
+            self._bad_reference("fmi2GetString", "String", vrs, frozenset())
+        return [""] * len(vrs)
+
+    def set_boolean(self, vrs: list[int], values: list[bool]) -> None:
+        if vrs:
+            self._bad_reference("fmi2SetBoolean", "Boolean", vrs, frozenset())
+
+    def set_string(self, vrs: list[int], values: list[str]) -> None:
+        if vrs:
+            self._bad_reference("fmi2SetString", "String", vrs, frozenset())
+
     # -- complete state ---------------------------------------------------------------
     def _get_fmu_state(self) -> dict[str, Any]:
         return {
+            "fmu": self.component,
             "component": self.model.get_state(),
             "stale": self._feedthrough_stale,
-            "not_finite": frozenset(self._not_finite),
+            "init_stale": self._init_stale,
+            "phase": (self._initializing, self._initialized),
+            "time": (self._start_time, self._t_end, self._last_h),
         }
 
     def _set_fmu_state(self, state: dict[str, Any]) -> None:
+        owner = state.get("fmu") if isinstance(state, dict) else None
+        if owner != self.component:
+            self._refuse(
+                f"fmi2SetFMUstate: the state is of {owner or 'no FMU of ours'}, "
+                f"not of {self.component}"
+            )
+            return
         self.model.set_state(state["component"])
         self._feedthrough_stale = state["stale"]
-        self._not_finite = set(state["not_finite"])
+        self._init_stale = state["init_stale"]
+        self._initializing, self._initialized = state["phase"]
+        self._start_time, self._t_end, self._last_h = state["time"]
+
+
+#: A step starts where the last ended, up to this relative difference (a host that computes
+#: t_k = k h rather than summing the steps).
+TIME_MATCH = 1e-9
 
 
 def _component_class(path: str) -> type[Component]:

@@ -22,6 +22,7 @@ from pathlib import Path
 from components.base import COMMON_OUTPUTS, Component
 from fmus.description import EVENT_TIME, INDICATOR_PREFIX, REGIME
 from fmus.example_scenes import ExampleScene
+from fmus.host_loader import RUNTIME_FILE, loader_binary, newest_version_needed, runtime_binary
 from fmus.ports import PORT_RULE
 from fmus.registry import FmuRecord
 
@@ -344,6 +345,18 @@ def _host_section(record: FmuRecord, loader: bool) -> str:
             "(<code>executable=</code>, <code>library=</code>) into "
             "<code>resources/python.txt</code> inside the FMU. The first FMU that starts "
             "Python in a process starts it for all.</li>\n"
+        )
+        binaries = [b for b in (loader_binary(record.name), runtime_binary()) if b]
+        glibc = newest_version_needed(binaries, b"GLIBC_")
+        cxx = newest_version_needed(binaries, b"GLIBCXX_")
+        other_hosts += (
+            "<li><strong>What the Linux binaries need</strong> (x86-64): the loader "
+            f"<code>binaries/linux64/{escape(record.name)}.so</code> needs glibc "
+            f"{escape(glibc or '?')} or later and a Python {escape(version)} (exactly: it "
+            "starts that version's interpreter, and refuses at fmi2Instantiate anything "
+            "else named by <code>MECHCOSIM_PYTHON</code>); pythonfmu's runtime beside it, "
+            f"<code>{RUNTIME_FILE}</code>, needs libstdc++ with GLIBCXX_{escape(cxx or '?')} "
+            "and libgcc_s.</li>\n"
         )
         errors = (
             "<li>Whatever the FMU logs with a status other than fmi2OK reaches the host's "

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import hashlib
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -175,3 +176,22 @@ def pack_loader(members: dict[str, bytes], model_identifier: str, loader: bytes)
     members[f"binaries/{PLATFORM}/{RUNTIME_FILE}"] = members[binary]
     members[binary] = loader
     members[PYTHON_FILE] = loader_plan().python_record.encode()
+
+
+def runtime_binary() -> bytes | None:
+    """pythonfmu's Linux runtime as installed (what every FMU packs), or None."""
+    import pythonfmu
+
+    path = Path(pythonfmu.__file__).parent / "resources" / "binaries" / PLATFORM / RUNTIME_FILE
+    return path.read_bytes() if path.is_file() else None
+
+
+def newest_version_needed(binaries: list[bytes], prefix: bytes) -> str | None:
+    """The newest symbol version named ``prefix`` + digits (b"GLIBC_", b"GLIBCXX_") the ELF
+    ``binaries`` need, e.g. "2.34", from their version-need strings; None where none does."""
+    found = {
+        tuple(int(x) for x in m.split(b"."))
+        for data in binaries
+        for m in re.findall(re.escape(prefix) + rb"(\d+(?:\.\d+)+)", data)
+    }
+    return ".".join(str(x) for x in max(found)) if found else None

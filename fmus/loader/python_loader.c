@@ -88,83 +88,129 @@ typedef struct {
     size_t n_categories; /* 0: all categories */
     char** categories;
     int failed;         /* the runtime answered fmi2Fatal: do not call it again */
+    int phase;          /* where the instance is in FMI 2.0's state machine (Phase) */
+    int refused;        /* the runtime logged an fmi2Error message during the current call */
 } Instance;
 
-/* The functions that take an instance, with how the loader calls the runtime's. */
-#define INSTANCE_FUNCTIONS(X)                                                                   \
-    X(fmi2SetupExperiment,                                                                      \
+/* FMI 2.0's co-simulation states (4.2.4, figure "Calling sequence of Co-Simulation C
+ * functions").  Every step is synchronous here: "step in progress" and "step canceled"
+ * are never entered, and fmi2CancelStep is never allowed. */
+enum Phase {
+    INSTANTIATED,
+    INITIALIZATION_MODE,
+    STEP_COMPLETE,
+    STEP_IN_PROGRESS,
+    STEP_FAILED,
+    STEP_CANCELED,
+    TERMINATED,
+    ERROR_STATE,
+    FATAL_STATE,
+    N_PHASES
+};
+static const char* const PHASE_NAMES[N_PHASES] = {
+    "instantiated",      "initialization mode", "step complete",
+    "step in progress",  "step failed",         "step canceled",
+    "terminated",        "error",               "fatal"};
+#define IN(p) (1u << (p))
+#define ANY_BUT_FATAL                                                                           \
+    (IN(INSTANTIATED) | IN(INITIALIZATION_MODE) | IN(STEP_COMPLETE) | IN(STEP_FAILED) |         \
+     IN(STEP_CANCELED) | IN(TERMINATED) | IN(ERROR_STATE))
+#define SETTABLE (IN(INSTANTIATED) | IN(INITIALIZATION_MODE) | IN(STEP_COMPLETE))
+#define READABLE                                                                                \
+    (IN(INITIALIZATION_MODE) | IN(STEP_COMPLETE) | IN(STEP_FAILED) | IN(STEP_CANCELED) |        \
+     IN(TERMINATED) | IN(ERROR_STATE))
+#define AFTER_STEPS (IN(STEP_COMPLETE) | IN(STEP_FAILED) | IN(STEP_CANCELED) | IN(TERMINATED))
+
+/* The functions that take an instance: the states FMI 2.0 allows each in, and how the
+ * loader calls the runtime's.  The forwarded ones change no state themselves; the
+ * loader's own wrappers (below) move the instance from state to state. */
+#define FORWARDED_FUNCTIONS(X)                                                                  \
+    X(fmi2SetupExperiment, IN(INSTANTIATED),                                                    \
       (fmi2Component c, fmi2Boolean toleranceDefined, fmi2Real tolerance, fmi2Real startTime,   \
        fmi2Boolean stopTimeDefined, fmi2Real stopTime),                                         \
       (i->inner, toleranceDefined, tolerance, startTime, stopTimeDefined, stopTime))            \
-    X(fmi2EnterInitializationMode, (fmi2Component c), (i->inner))                               \
-    X(fmi2ExitInitializationMode, (fmi2Component c), (i->inner))                                \
-    X(fmi2Terminate, (fmi2Component c), (i->inner))                                             \
-    X(fmi2Reset, (fmi2Component c), (i->inner))                                                 \
-    X(fmi2GetReal, (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Real v[]),  \
+    X(fmi2GetReal, READABLE,                                                                    \
+      (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Real v[]),               \
       (i->inner, vr, nvr, v))                                                                   \
-    X(fmi2GetInteger,                                                                           \
+    X(fmi2GetInteger, READABLE,                                                                 \
       (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Integer v[]),            \
       (i->inner, vr, nvr, v))                                                                   \
-    X(fmi2GetBoolean,                                                                           \
+    X(fmi2GetBoolean, READABLE,                                                                 \
       (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Boolean v[]),            \
       (i->inner, vr, nvr, v))                                                                   \
-    X(fmi2GetString,                                                                            \
+    X(fmi2GetString, READABLE,                                                                  \
       (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2String v[]),             \
       (i->inner, vr, nvr, v))                                                                   \
-    X(fmi2SetReal,                                                                              \
+    X(fmi2SetReal, SETTABLE,                                                                    \
       (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Real v[]),         \
       (i->inner, vr, nvr, v))                                                                   \
-    X(fmi2SetInteger,                                                                           \
+    X(fmi2SetInteger, SETTABLE,                                                                 \
       (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Integer v[]),      \
       (i->inner, vr, nvr, v))                                                                   \
-    X(fmi2SetBoolean,                                                                           \
+    X(fmi2SetBoolean, SETTABLE,                                                                 \
       (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Boolean v[]),      \
       (i->inner, vr, nvr, v))                                                                   \
-    X(fmi2SetString,                                                                            \
+    X(fmi2SetString, SETTABLE,                                                                  \
       (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2String v[]),       \
       (i->inner, vr, nvr, v))                                                                   \
-    X(fmi2GetFMUstate, (fmi2Component c, fmi2FMUstate * state), (i->inner, state))              \
-    X(fmi2SetFMUstate, (fmi2Component c, fmi2FMUstate state), (i->inner, state))                \
-    X(fmi2FreeFMUstate, (fmi2Component c, fmi2FMUstate * state), (i->inner, state))            \
-    X(fmi2SerializedFMUstateSize, (fmi2Component c, fmi2FMUstate state, size_t * size),        \
-      (i->inner, state, size))                                                                  \
-    X(fmi2SerializeFMUstate,                                                                    \
-      (fmi2Component c, fmi2FMUstate state, fmi2Byte bytes[], size_t size),                     \
-      (i->inner, state, bytes, size))                                                           \
-    X(fmi2DeSerializeFMUstate,                                                                  \
-      (fmi2Component c, const fmi2Byte bytes[], size_t size, fmi2FMUstate * state),             \
-      (i->inner, bytes, size, state))                                                           \
-    X(fmi2GetDirectionalDerivative,                                                             \
+    X(fmi2GetDirectionalDerivative, READABLE,                                                   \
       (fmi2Component c, const fmi2ValueReference unknown[], size_t n_unknown,                   \
        const fmi2ValueReference known[], size_t n_known, const fmi2Real dv_known[],             \
        fmi2Real dv_unknown[]),                                                                  \
       (i->inner, unknown, n_unknown, known, n_known, dv_known, dv_unknown))                     \
-    X(fmi2SetRealInputDerivatives,                                                              \
+    X(fmi2SetRealInputDerivatives, SETTABLE,                                                    \
       (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Integer order[],   \
        const fmi2Real v[]),                                                                     \
       (i->inner, vr, nvr, order, v))                                                            \
-    X(fmi2GetRealOutputDerivatives,                                                             \
+    X(fmi2GetRealOutputDerivatives, AFTER_STEPS | IN(ERROR_STATE),                             \
       (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Integer order[],   \
        fmi2Real v[]),                                                                           \
       (i->inner, vr, nvr, order, v))                                                            \
-    X(fmi2DoStep,                                                                               \
+    X(fmi2CancelStep, IN(STEP_IN_PROGRESS), (fmi2Component c), (i->inner))                      \
+    X(fmi2GetStatus, AFTER_STEPS,                                                               \
+      (fmi2Component c, const fmi2StatusKind s, fmi2Status * v),                                \
+      (i->inner, s, v))                                                                         \
+    X(fmi2GetRealStatus, AFTER_STEPS,                                                           \
+      (fmi2Component c, const fmi2StatusKind s, fmi2Real * v),                                  \
+      (i->inner, s, v))                                                                         \
+    X(fmi2GetIntegerStatus, AFTER_STEPS,                                                        \
+      (fmi2Component c, const fmi2StatusKind s, fmi2Integer * v),                               \
+      (i->inner, s, v))                                                                         \
+    X(fmi2GetBooleanStatus, AFTER_STEPS,                                                        \
+      (fmi2Component c, const fmi2StatusKind s, fmi2Boolean * v),                               \
+      (i->inner, s, v))                                                                         \
+    X(fmi2GetStringStatus, AFTER_STEPS,                                                         \
+      (fmi2Component c, const fmi2StatusKind s, fmi2String * v),                                \
+      (i->inner, s, v))
+
+#define OWN_FUNCTIONS(X)                                                                        \
+    X(fmi2EnterInitializationMode, IN(INSTANTIATED), (fmi2Component c), (i->inner))             \
+    X(fmi2ExitInitializationMode, IN(INITIALIZATION_MODE), (fmi2Component c), (i->inner))       \
+    X(fmi2Terminate, IN(STEP_COMPLETE) | IN(STEP_FAILED) | IN(STEP_CANCELED),                   \
+      (fmi2Component c),                                                                        \
+      (i->inner))                                                                               \
+    X(fmi2Reset, ANY_BUT_FATAL, (fmi2Component c), (i->inner))                                  \
+    X(fmi2GetFMUstate, ANY_BUT_FATAL, (fmi2Component c, fmi2FMUstate * state), (i->inner, state)) \
+    X(fmi2SetFMUstate, ANY_BUT_FATAL, (fmi2Component c, fmi2FMUstate state), (i->inner, state)) \
+    X(fmi2FreeFMUstate, ANY_BUT_FATAL, (fmi2Component c, fmi2FMUstate * state), (i->inner, state)) \
+    X(fmi2SerializedFMUstateSize, ANY_BUT_FATAL,                                                \
+      (fmi2Component c, fmi2FMUstate state, size_t * size),                                     \
+      (i->inner, state, size))                                                                  \
+    X(fmi2SerializeFMUstate, ANY_BUT_FATAL,                                                     \
+      (fmi2Component c, fmi2FMUstate state, fmi2Byte bytes[], size_t size),                     \
+      (i->inner, state, bytes, size))                                                           \
+    X(fmi2DeSerializeFMUstate, ANY_BUT_FATAL,                                                   \
+      (fmi2Component c, const fmi2Byte bytes[], size_t size, fmi2FMUstate * state),             \
+      (i->inner, bytes, size, state))                                                           \
+    X(fmi2DoStep, IN(STEP_COMPLETE),                                                            \
       (fmi2Component c, fmi2Real currentCommunicationPoint, fmi2Real communicationStepSize,     \
        fmi2Boolean noSetFMUStatePriorToCurrentCommunicationPoint),                              \
       (i->inner, currentCommunicationPoint, communicationStepSize,                              \
-       noSetFMUStatePriorToCurrentCommunicationPoint))                                          \
-    X(fmi2CancelStep, (fmi2Component c), (i->inner))                                            \
-    X(fmi2GetStatus, (fmi2Component c, const fmi2StatusKind s, fmi2Status * v),                 \
-      (i->inner, s, v))                                                                         \
-    X(fmi2GetRealStatus, (fmi2Component c, const fmi2StatusKind s, fmi2Real * v),               \
-      (i->inner, s, v))                                                                         \
-    X(fmi2GetIntegerStatus, (fmi2Component c, const fmi2StatusKind s, fmi2Integer * v),         \
-      (i->inner, s, v))                                                                         \
-    X(fmi2GetBooleanStatus, (fmi2Component c, const fmi2StatusKind s, fmi2Boolean * v),         \
-      (i->inner, s, v))                                                                         \
-    X(fmi2GetStringStatus, (fmi2Component c, const fmi2StatusKind s, fmi2String * v),           \
-      (i->inner, s, v))
+       noSetFMUStatePriorToCurrentCommunicationPoint))
 
-#define DECLARE(name, params, args) EXPORT fmi2Status name params;
+#define INSTANCE_FUNCTIONS(X) FORWARDED_FUNCTIONS(X) OWN_FUNCTIONS(X)
+
+#define DECLARE(name, allowed, params, args) EXPORT fmi2Status name params;
 INSTANCE_FUNCTIONS(DECLARE)
 
 /* The runtime's entry points, found once. */
@@ -174,7 +220,7 @@ static struct {
                                      const fmi2CallbackFunctions*, fmi2Boolean, fmi2Boolean);
     void (*fmi2FreeInstance)(fmi2Component);
     void (*finalizePythonInterpreter)(void);
-#define POINTER(name, params, args) fmi2Status(*name) params;
+#define POINTER(name, allowed, params, args) fmi2Status(*name) params;
     INSTANCE_FUNCTIONS(POINTER)
 } runtime;
 
@@ -232,6 +278,7 @@ static void relay(fmi2ComponentEnvironment env, fmi2String name, fmi2Status stat
                   fmi2String category, fmi2String message, ...) {
     Instance* i = env;
     if (i == NULL) return;
+    if (status == fmi2Error) i->refused = 1;
     if (status == fmi2OK) {
         if (!i->debug) return;
         if (i->n_categories > 0) {
@@ -348,7 +395,30 @@ static void library_beside(const char* base_bin, int major, int minor, char* lib
 static int check_version(PythonChoice* choice, char* why) {
     char base_bin[PATH_MAX];
     int major, minor;
+    if (access(choice->executable, X_OK) != 0) {
+        snprintf(why, WHY_SIZE, "the Python executable %s (from %s) is not there or not "
+                 "executable; set %s to a Python %d.%d executable", choice->executable,
+                 choice->source, PYTHON_VARIABLE, PY_MAJOR_VERSION, PY_MINOR_VERSION);
+        return 0;
+    }
     inspect_executable(choice->executable, base_bin, &major, &minor);
+    if (major == 0) {
+        /* neither its name nor a pyvenv.cfg tells: its installation's standard library does */
+        char stdlib[PATH_MAX + 64], real[PATH_MAX] = "";
+        snprintf(stdlib, sizeof stdlib, "%s/../lib/python%d.%d/os.py", base_bin,
+                 PY_MAJOR_VERSION, PY_MINOR_VERSION);
+        const char* name = realpath(choice->executable, real) ? strrchr(real, '/') : NULL;
+        if (name == NULL || strncmp(name + 1, "python", 6) != 0 || access(stdlib, R_OK) != 0) {
+            snprintf(why, WHY_SIZE,
+                     "%s (from %s) is not a Python %d.%d executable (not named python%d.%d, "
+                     "no pyvenv.cfg beside it, or no lib/python%d.%d/os.py in its "
+                     "installation); set %s to a Python %d.%d executable",
+                     choice->executable, choice->source, PY_MAJOR_VERSION, PY_MINOR_VERSION,
+                     PY_MAJOR_VERSION, PY_MINOR_VERSION, PY_MAJOR_VERSION, PY_MINOR_VERSION,
+                     PYTHON_VARIABLE, PY_MAJOR_VERSION, PY_MINOR_VERSION);
+            return 0;
+        }
+    }
     if (major != 0 && (major != PY_MAJOR_VERSION || minor != PY_MINOR_VERSION)) {
         snprintf(why, WHY_SIZE,
                  "the FMU was built for Python %d.%d, but %s (from %s) is Python %d.%d; set "
@@ -509,7 +579,7 @@ static void release_runtime(void) {
             return 0;                                                                           \
         }                                                                                       \
     } while (0)
-#define RESOLVE(name, params, args) RUNTIME_FUNCTION(name);
+#define RESOLVE(name, allowed, params, args) RUNTIME_FUNCTION(name);
 
 static int load_runtime(const char* binaries, char* why) {
     char path[PATH_MAX + 64];
@@ -544,6 +614,111 @@ static int prepare(char* why) {
     return ok;
 }
 
+/* -- the resource location ------------------------------------------------------------- */
+static int hex_digit(char c) {
+    if (c >= '0' && c <= '9') return c - '0';
+    if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+    if (c >= 'A' && c <= 'F') return c - 'A' + 10;
+    return -1;
+}
+
+/* The resource location as pythonfmu's runtime takes it, "file://" and a plain absolute path
+ * (it strips exactly that prefix).  FMI 2.0 (2.1.6, fmi2Instantiate) gives the location as a
+ * URI (RFC 3986): "file:///p", "file:/p" and "file://localhost/p" name the same directory,
+ * its characters may be percent-escaped ("%20" for a space), and a plain absolute path is
+ * taken as it is. */
+static int resource_path(const char* location, char* out, size_t size, char* why) {
+    const char* path = location;
+    if (strncmp(location, "file:", 5) == 0) {
+        path = location + 5;
+        if (strncmp(path, "//", 2) == 0) {
+            path += 2; /* an authority: empty or localhost, then the absolute path */
+            if (strncmp(path, "localhost/", 10) == 0) path += 9;
+        }
+    }
+    if (path[0] != '/') {
+        snprintf(why, WHY_SIZE,
+                 "fmi2Instantiate: resource location \"%.1024s\" is no file URI of a local "
+                 "absolute path (expected file:///path, file:/path or file://localhost/path)",
+                 location);
+        return 0;
+    }
+    size_t n = (size_t)snprintf(out, size, "file://");
+    for (const char* p = path; *p; ++p) {
+        char c = *p;
+        if (c == '%') {
+            int high = hex_digit(p[1]), low = high < 0 ? -1 : hex_digit(p[2]);
+            if (low < 0) {
+                snprintf(why, WHY_SIZE,
+                         "fmi2Instantiate: resource location \"%.1024s\" has a '%%' that is not "
+                         "followed by two hexadecimal digits", location);
+                return 0;
+            }
+            c = (char)(high * 16 + low);
+            p += 2;
+        }
+        if (c == '\0' || n + 1 >= size) {
+            snprintf(why, WHY_SIZE, "fmi2Instantiate: resource location \"%.1024s\" is %s",
+                     location, c == '\0' ? "a path with an escaped NUL" : "too long");
+            return 0;
+        }
+        out[n++] = c;
+    }
+    out[n] = '\0';
+    /* the runtime reads the name of the slave's module there, and crashes without it */
+    char marker[PATH_MAX + 64];
+    snprintf(marker, sizeof marker, "%s/slavemodule.txt", out + 7);
+    if (access(marker, R_OK) != 0) {
+        snprintf(why, WHY_SIZE,
+                 "fmi2Instantiate: resource location \"%.1024s\" is not this FMU's resources "
+                 "directory (no slavemodule.txt in %.1024s)", location, out + 7);
+        return 0;
+    }
+    return 1;
+}
+
+/* -- what is instantiated ---------------------------------------------------------------- */
+/* The GUID of this FMU's model description (FMI 2.0, 2.1.6: fmi2Instantiate checks the one
+ * the host read against it); "" where the unpacked FMU has no modelDescription.xml. */
+static void own_guid(char* guid, size_t size) {
+    guid[0] = '\0';
+    char binaries[PATH_MAX], why[WHY_SIZE];
+    if (!own_directory(binaries, sizeof binaries, why)) return;
+    char path[PATH_MAX + 64];
+    snprintf(path, sizeof path, "%s/../../modelDescription.xml", binaries);
+    FILE* f = fopen(path, "r");
+    if (f == NULL) return;
+    char text[16384];
+    size_t n = fread(text, 1, sizeof text - 1, f);
+    fclose(f);
+    text[n] = '\0';
+    const char* root = strstr(text, "<fmiModelDescription");
+    const char* at = root ? strstr(root, " guid=\"") : NULL;
+    if (at == NULL) return;
+    at += 7;
+    const char* end = strchr(at, '"');
+    if (end == NULL || (size_t)(end - at) >= size) return;
+    memcpy(guid, at, (size_t)(end - at));
+    guid[end - at] = '\0';
+}
+
+static int instantiable(fmi2Type type, fmi2String guid, char* why) {
+    if (type != fmi2CoSimulation) {
+        snprintf(why, WHY_SIZE, "fmi2Instantiate: this FMU is for co-simulation only "
+                 "(fmuType %d asked, fmi2CoSimulation is %d)", (int)type, (int)fmi2CoSimulation);
+        return 0;
+    }
+    char own[128];
+    own_guid(own, sizeof own);
+    if (own[0] && (guid == NULL || strcmp(guid, own) != 0)) {
+        snprintf(why, WHY_SIZE, "fmi2Instantiate: GUID \"%.200s\" is not this FMU's (%s): the "
+                 "model description the host read is of another FMU or another build of it",
+                 guid ? guid : "(null)", own);
+        return 0;
+    }
+    return 1;
+}
+
 /* -- FMI 2.0 ---------------------------------------------------------------------------------- */
 EXPORT const char* fmi2GetTypesPlatform(void) { return "default"; }
 
@@ -572,6 +747,10 @@ EXPORT fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, 
         emit(functions, name, fmi2Error, "logStatusError", why);
         return NULL;
     }
+    if (!instantiable(fmuType, fmuGUID, why)) {
+        emit(functions, name, fmi2Error, "logStatusError", why);
+        return NULL;
+    }
     Instance* i = calloc(1, sizeof *i);
     if (i == NULL || (i->name = strdup(name)) == NULL) {
         free(i);
@@ -594,11 +773,14 @@ EXPORT fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, 
             return NULL;
         }
         snprintf(resources, sizeof resources, "file://%s/../../resources", binaries);
-        fmuResourceLocation = resources;
+    } else if (!resource_path(fmuResourceLocation, resources, sizeof resources, why)) {
+        emit(functions, name, fmi2Error, "logStatusError", why);
+        free_instance(i);
+        return NULL;
     }
     /* The runtime logs with debug logging on, always: relay() does the filtering. */
-    i->inner = runtime.fmi2Instantiate(instanceName, fmuType, fmuGUID, fmuResourceLocation,
-                                       &i->relayed, visible, 1);
+    i->inner = runtime.fmi2Instantiate(instanceName, fmuType, fmuGUID, resources, &i->relayed,
+                                       visible, 1);
     if (i->inner == NULL) { /* the runtime has logged why */
         free_instance(i);
         return NULL;
@@ -613,7 +795,10 @@ EXPORT void fmi2FreeInstance(fmi2Component c) {
     free_instance(i);
 }
 
-static int usable(Instance* i, const char* function) {
+/* Whether `function` may be called now; if not, why is logged and the instance is in the
+ * error state (FMI 2.0, 2.1.3: after fmi2Error only fmi2SetFMUstate to an earlier state,
+ * fmi2Reset, reading values and fmi2FreeInstance). */
+static int admit(Instance* i, const char* function, unsigned allowed) {
     if (i == NULL) return 0;
     if (i->failed) {
         char why[256];
@@ -622,13 +807,43 @@ static int usable(Instance* i, const char* function) {
         emit(&i->host, i->name, fmi2Error, "logStatusError", why);
         return 0;
     }
-    return 1;
+    if (allowed & IN(i->phase)) {
+        i->refused = 0;
+        return 1;
+    }
+    char why[512];
+    int n = snprintf(why, sizeof why, "%s: not allowed in state %s (FMI 2.0 allows it in: ",
+                     function, PHASE_NAMES[i->phase]);
+    const char* sep = "";
+    for (int p = 0; p < N_PHASES && n > 0 && (size_t)n < sizeof why; ++p) {
+        if (!(allowed & IN(p))) continue;
+        n += snprintf(why + n, sizeof why - (size_t)n, "%s%s", sep, PHASE_NAMES[p]);
+        sep = ", ";
+    }
+    if (n > 0 && (size_t)n < sizeof why)
+        snprintf(why + n, sizeof why - (size_t)n, "%s)", allowed ? "" : "no state");
+    emit(&i->host, i->name, fmi2Error, "logStatusError", why);
+    i->phase = ERROR_STATE;
+    return 0;
+}
+
+/* The status to answer: the runtime's, but fmi2Error where the FMU's code refused the call
+ * (it logs why with fmi2Error and returns normally: an exception would be fmi2Fatal in
+ * pythonfmu's runtime).  fmi2Error and fmi2Fatal move the instance to those states. */
+static fmi2Status settle(Instance* i, fmi2Status status) {
+    if (status == fmi2OK && i->refused) status = fmi2Error;
+    if (status == fmi2Error) i->phase = ERROR_STATE;
+    if (status == fmi2Fatal) {
+        i->phase = FATAL_STATE;
+        i->failed = 1;
+    }
+    return status;
 }
 
 EXPORT fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, size_t nCategories,
                                       const fmi2String categories[]) {
     Instance* i = c;
-    if (!usable(i, "fmi2SetDebugLogging")) return fmi2Error;
+    if (!admit(i, "fmi2SetDebugLogging", ANY_BUT_FATAL)) return fmi2Error;
     free_categories(i);
     if (nCategories > 0 && categories) {
         i->categories = calloc(nCategories, sizeof *i->categories);
@@ -643,12 +858,170 @@ EXPORT fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, si
     return fmi2OK;
 }
 
-#define FORWARD(name, params, args)                                                             \
+#define FORWARD(name, allowed, params, args)                                                    \
     EXPORT fmi2Status name params {                                                             \
         Instance* i = c;                                                                        \
-        if (!usable(i, #name)) return fmi2Error;                                                \
-        fmi2Status status = runtime.name args;                                                  \
-        if (status == fmi2Fatal) i->failed = 1;                                                 \
+        if (!admit(i, #name, allowed)) return fmi2Error;                                        \
+        return settle(i, runtime.name args);                                                    \
+    }
+FORWARDED_FUNCTIONS(FORWARD)
+
+/* The calls that move the instance: to `next` when the runtime accepts. */
+#define MOVE(name, next)                                                                        \
+    EXPORT fmi2Status name(fmi2Component c) {                                                   \
+        Instance* i = c;                                                                        \
+        if (!admit(i, #name, ALLOWED_##name)) return fmi2Error;                                 \
+        fmi2Status status = settle(i, runtime.name(i->inner));                                  \
+        if (status == fmi2OK) i->phase = next;                                                  \
         return status;                                                                          \
     }
-INSTANCE_FUNCTIONS(FORWARD)
+#define ALLOWED(name, allowed, params, args) enum { ALLOWED_##name = allowed };
+OWN_FUNCTIONS(ALLOWED)
+MOVE(fmi2EnterInitializationMode, INITIALIZATION_MODE)
+MOVE(fmi2ExitInitializationMode, STEP_COMPLETE)
+MOVE(fmi2Terminate, TERMINATED)
+MOVE(fmi2Reset, INSTANTIATED)
+
+EXPORT fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint,
+                             fmi2Real communicationStepSize,
+                             fmi2Boolean noSetFMUStatePriorToCurrentCommunicationPoint) {
+    Instance* i = c;
+    if (!admit(i, "fmi2DoStep", ALLOWED_fmi2DoStep)) return fmi2Error;
+    fmi2Status status =
+        settle(i, runtime.fmi2DoStep(i->inner, currentCommunicationPoint, communicationStepSize,
+                                     noSetFMUStatePriorToCurrentCommunicationPoint));
+    if (status == fmi2OK) i->phase = STEP_COMPLETE;
+    if (status == fmi2Discard) i->phase = STEP_FAILED;
+    return status;
+}
+
+/* -- FMU states ------------------------------------------------------------------------------ */
+/* What the host holds as an FMU state: the runtime's, with the state-machine state it was
+ * taken in, marked as this FMU's (a state of another FMU is refused, not handed on). */
+#define STATE_MARK 0x6d637373u /* "mcss" */
+typedef struct {
+    unsigned mark;
+    const void* owner; /* this loader's copy: one per FMU binary */
+    int phase;
+    fmi2FMUstate inner;
+} SavedState;
+
+static SavedState* own_state(Instance* i, const char* function, fmi2FMUstate state) {
+    SavedState* saved = state;
+    if (saved != NULL && saved->mark == STATE_MARK && saved->owner == (const void*)&runtime)
+        return saved;
+    char why[256];
+    snprintf(why, sizeof why, "%s: the FMU state given is %s", function,
+             state == NULL ? "NULL" : "not one this FMU made (another FMU's, or freed)");
+    emit(&i->host, i->name, fmi2Error, "logStatusError", why);
+    i->phase = ERROR_STATE;
+    return NULL;
+}
+
+EXPORT fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate* state) {
+    Instance* i = c;
+    if (!admit(i, "fmi2GetFMUstate", ALLOWED_fmi2GetFMUstate)) return fmi2Error;
+    if (state == NULL) {
+        emit(&i->host, i->name, fmi2Error, "logStatusError", "fmi2GetFMUstate: state is NULL");
+        return settle(i, fmi2Error);
+    }
+    SavedState* saved = NULL;
+    if (*state != NULL) { /* FMI 2.0: a state given is updated in place */
+        if ((saved = own_state(i, "fmi2GetFMUstate", *state)) == NULL) return fmi2Error;
+        fmi2Status freed = settle(i, runtime.fmi2FreeFMUstate(i->inner, &saved->inner));
+        if (freed != fmi2OK) return freed;
+    } else if ((saved = calloc(1, sizeof *saved)) == NULL) {
+        emit(&i->host, i->name, fmi2Error, "logStatusError", "fmi2GetFMUstate: out of memory");
+        return settle(i, fmi2Error);
+    }
+    saved->inner = NULL;
+    fmi2Status status = settle(i, runtime.fmi2GetFMUstate(i->inner, &saved->inner));
+    if (status != fmi2OK) {
+        free(saved);
+        *state = NULL;
+        return status;
+    }
+    saved->mark = STATE_MARK;
+    saved->owner = (const void*)&runtime;
+    saved->phase = i->phase;
+    *state = saved;
+    return status;
+}
+
+EXPORT fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate state) {
+    Instance* i = c;
+    if (!admit(i, "fmi2SetFMUstate", ALLOWED_fmi2SetFMUstate)) return fmi2Error;
+    SavedState* saved = own_state(i, "fmi2SetFMUstate", state);
+    if (saved == NULL) return fmi2Error;
+    fmi2Status status = settle(i, runtime.fmi2SetFMUstate(i->inner, saved->inner));
+    if (status == fmi2OK) i->phase = saved->phase;
+    return status;
+}
+
+EXPORT fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate* state) {
+    Instance* i = c;
+    if (!admit(i, "fmi2FreeFMUstate", ALLOWED_fmi2FreeFMUstate)) return fmi2Error;
+    if (state == NULL || *state == NULL) return fmi2OK; /* nothing to free */
+    SavedState* saved = own_state(i, "fmi2FreeFMUstate", *state);
+    if (saved == NULL) return fmi2Error;
+    fmi2Status status = settle(i, runtime.fmi2FreeFMUstate(i->inner, &saved->inner));
+    saved->mark = 0;
+    free(saved);
+    *state = NULL;
+    return status;
+}
+
+/* Serialized: the state-machine state (4 bytes), then the runtime's bytes. */
+#define STATE_HEADER 8
+EXPORT fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate state, size_t* size) {
+    Instance* i = c;
+    if (!admit(i, "fmi2SerializedFMUstateSize", ALLOWED_fmi2SerializedFMUstateSize))
+        return fmi2Error;
+    SavedState* saved = own_state(i, "fmi2SerializedFMUstateSize", state);
+    if (saved == NULL) return fmi2Error;
+    size_t inner = 0;
+    fmi2Status status =
+        settle(i, runtime.fmi2SerializedFMUstateSize(i->inner, saved->inner, &inner));
+    if (status == fmi2OK && size) *size = inner + STATE_HEADER;
+    return status;
+}
+
+EXPORT fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate state, fmi2Byte bytes[],
+                                        size_t size) {
+    Instance* i = c;
+    if (!admit(i, "fmi2SerializeFMUstate", ALLOWED_fmi2SerializeFMUstate)) return fmi2Error;
+    SavedState* saved = own_state(i, "fmi2SerializeFMUstate", state);
+    if (saved == NULL) return fmi2Error;
+    if (size < STATE_HEADER) return settle(i, fmi2Error);
+    unsigned header[2] = {STATE_MARK, (unsigned)saved->phase};
+    memcpy(bytes, header, STATE_HEADER);
+    return settle(i, runtime.fmi2SerializeFMUstate(i->inner, saved->inner, bytes + STATE_HEADER,
+                                                   size - STATE_HEADER));
+}
+
+EXPORT fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte bytes[], size_t size,
+                                          fmi2FMUstate* state) {
+    Instance* i = c;
+    if (!admit(i, "fmi2DeSerializeFMUstate", ALLOWED_fmi2DeSerializeFMUstate)) return fmi2Error;
+    unsigned header[2] = {0, 0};
+    if (bytes != NULL && size >= STATE_HEADER) memcpy(header, bytes, STATE_HEADER);
+    if (state == NULL || header[0] != STATE_MARK || header[1] >= N_PHASES) {
+        emit(&i->host, i->name, fmi2Error, "logStatusError",
+             "fmi2DeSerializeFMUstate: the bytes given are no FMU state this FMU serialized");
+        return settle(i, fmi2Error);
+    }
+    SavedState* saved = calloc(1, sizeof *saved);
+    if (saved == NULL) return settle(i, fmi2Error);
+    fmi2Status status = settle(i, runtime.fmi2DeSerializeFMUstate(
+                                      i->inner, bytes + STATE_HEADER, size - STATE_HEADER,
+                                      &saved->inner));
+    if (status != fmi2OK) {
+        free(saved);
+        return status;
+    }
+    saved->mark = STATE_MARK;
+    saved->owner = (const void*)&runtime;
+    saved->phase = (int)header[1];
+    *state = saved;
+    return status;
+}

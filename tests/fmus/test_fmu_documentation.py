@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import re
+import sys
 import tomllib
 from functools import cache
 from html.parser import HTMLParser
@@ -293,3 +294,18 @@ def test_editing_an_example_scenes_values_rebuilds_no_fmu(tmp_path) -> None:
         last = text[text.rindex("[[connections]]") : text.index("[master]")]
         scene.write_text(text.replace(last, ""))
         assert content_hash(record) != before[0]
+
+
+def test_the_documentation_says_what_the_linux_binaries_need() -> None:
+    from fmus.documentation import _host_section
+    from fmus.host_loader import newest_version_needed
+
+    # version-need strings as an ELF's .gnu.version_r holds them: the newest, by number
+    data = b"\0GLIBC_2.7\0GLIBC_2.34\0GLIBC_2.14\0GLIBCXX_3.4.9\0GLIBCXX_3.4.30\0"
+    assert newest_version_needed([data], b"GLIBC_") == "2.34"
+    assert newest_version_needed([data], b"GLIBCXX_") == "3.4.30"
+    assert newest_version_needed([b"none"], b"GLIBC_") is None
+    html = _host_section(FMU_RECORDS["GearTrain"], loader=True)
+    version = f"{sys.version_info.major}.{sys.version_info.minor}"
+    assert re.search(r"needs glibc 2\.\d+ or later and a Python " + re.escape(version), html)
+    assert re.search(r"needs libstdc\+\+ with GLIBCXX_3\.4\.\d+ and libgcc_s", html)

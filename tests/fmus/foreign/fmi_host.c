@@ -29,7 +29,7 @@
 
 #include "fmi2Functions.h"
 
-#define MAX_FMUS 8
+#define MAX_FMUS 16
 #define MAX_VARS 64
 
 typedef struct {
@@ -161,7 +161,7 @@ static void load(Fmu* f) {
     f->do_step = function(f, "fmi2DoStep");
     f->types_platform = function(f, "fmi2GetTypesPlatform");
     f->version = function(f, "fmi2GetVersion");
-    snprintf(f->uri, sizeof f->uri, "file://%s/resources", f->dir);
+    if (f->uri[0] == '\0') snprintf(f->uri, sizeof f->uri, "file://%s/resources", f->dir);
     if (strcmp(f->version(), "2.0") != 0 || strcmp(f->types_platform(), "default") != 0)
         fail("version", f->id);
 }
@@ -272,9 +272,8 @@ static void sequence(Fmu* f, double start, int n) {
     f->free_instance(b);
     f->free_instance(c);
 
-    /* An unknown value reference: the runtime answers fmi2Fatal, the instance refuses every
-     * later call with fmi2Error, and freeing it does not crash.  No resource location: the
-     * FMU finds its own. */
+    /* An unknown value reference: fmi2Error, the instance is in the error state and refuses
+     * a step, and freeing it does not crash.  No resource location: the FMU finds its own. */
     snprintf(name, sizeof name, "%s_d", f->name);
     fmi2Component d =
         f->instantiate(name, fmi2CoSimulation, f->guid, NULL, &callbacks, fmi2False, fmi2False);
@@ -289,6 +288,20 @@ static void sequence(Fmu* f, double start, int n) {
     fmi2Status then = f->do_step(d, start, h, fmi2True);
     printf("%s:after an unknown value reference %d, then %d\n", f->name, first, then);
     f->free_instance(d);
+}
+
+/* One run: instantiate (at the job's resource location), initialize, step, free. */
+static void plain(Fmu* f, double start, int n) {
+    fmi2Component a = instantiate(f, f->name);
+    if (a == NULL) {
+        fail("fmi2Instantiate", f->id);
+        return;
+    }
+    initialize(f, a, start);
+    print_outputs(f, a, "run", start);
+    steps(f, a, "run", start, f->h, 0, n);
+    CHECK(f->terminate(a), "fmi2Terminate", f->id);
+    f->free_instance(a);
 }
 
 /* Fixed-step Jacobi: every FMU steps with the outputs of the last communication point. */
@@ -397,7 +410,7 @@ int main(int argc, char** argv) {
     while (fgets(line, sizeof line, job)) {
         char word[32];
         if (sscanf(line, "%31s", word) != 1) continue;
-        if (strcmp(word, "sequence") == 0) {
+        if (strcmp(word, "sequence") == 0 || strcmp(word, "plain") == 0) {
             snprintf(mode, sizeof mode, "%s", word);
             sscanf(line, "%*s %lf %d", &start, &n);
         } else if (strcmp(word, "jacobi") == 0) {
@@ -408,6 +421,8 @@ int main(int argc, char** argv) {
         } else if (strcmp(word, "fmu") == 0) {
             Fmu* f = &fmus[n_fmus++];
             sscanf(line, "%*s %63s %4095s %255s %127s", f->name, f->dir, f->id, f->guid);
+        } else if (strcmp(word, "uri") == 0) { /* the resource location, as written */
+            sscanf(line, "%*s %4199s", fmus[n_fmus - 1].uri);
         } else if (strcmp(word, "step") == 0) {
             sscanf(line, "%*s %lf", &fmus[n_fmus - 1].h);
         } else if (strcmp(word, "set") == 0 || strcmp(word, "out") == 0) {
@@ -426,6 +441,8 @@ int main(int argc, char** argv) {
     for (int j = 0; j < n_fmus; ++j) load(&fmus[j]);
     if (strcmp(mode, "sequence") == 0) {
         for (int j = 0; j < n_fmus; ++j) sequence(&fmus[j], start, n);
+    } else if (strcmp(mode, "plain") == 0) {
+        for (int j = 0; j < n_fmus; ++j) plain(&fmus[j], start, n);
     } else if (strcmp(mode, "jacobi") == 0) {
         jacobi(start, stop, h, n, threaded);
     }
