@@ -314,7 +314,11 @@ def lever_works(d: LeverDesign) -> tuple[tuple[float, float], tuple[float, float
 
 def _work_violations(d: LeverDesign) -> list[Violation]:
     out = []
-    measure = "sin" if d.switching_mode == PHASE_SCHEDULED else ""
+    phase = d.switching_mode == PHASE_SCHEDULED
+
+    def m(symbol: str) -> str:
+        return f"sin({symbol})" if phase else symbol
+
     for (impulse, unlock), side, names in zip(
         lever_works(d),
         ("moving negative", "moving positive"),
@@ -327,10 +331,9 @@ def _work_violations(d: LeverDesign) -> list[Violation]:
             out.append(
                 Violation(
                     "lever gives net work",
-                    f"{side}: impulse |{x3}| {measure}({a}) + |{x4}| {measure}({b}) = "
-                    f"{impulse:.6g}, unlock |{x2}| ({measure}({e}) - {measure}({a})) = "
-                    f"{unlock:.6g} (per drive torque / I); expected the impulse to give at "
-                    "least the work the unlock takes",
+                    f"{side}: impulse |{x3}| {m(a)} + |{x4}| {m(b)} = {impulse:.6g}, unlock "
+                    f"|{x2}| ({m(e)} - {m(a)}) = {unlock:.6g} (per drive torque / I); expected "
+                    "the impulse to give at least the work the unlock takes",
                 )
             )
     return out
