@@ -20,7 +20,7 @@ from components.detached_lever import (
 )
 from components.detached_lever_design import SEGMENTS, WINDOWS, LeverDesign, violations
 
-I = DetachedLever().inertia
+INERTIA = DetachedLever().inertia
 DRIVE = DetachedLever().drive_torque  # the worked example's impulse torque, 1245.8 I
 
 
@@ -43,11 +43,11 @@ def test_the_defaults_are_the_worked_example_cards() -> None:
     lever = DetachedLever()
     for s in SEGMENTS:
         expected = 305.546 if s.n <= 5 else -305.546
-        assert getattr(lever, s.coulomb) / I == pytest.approx(expected, rel=1e-14)
+        assert getattr(lever, s.coulomb) / INERTIA == pytest.approx(expected, rel=1e-14)
     card5 = {2: 143.41, 3: -1245.8, 4: -1245.8, 7: -143.41, 8: 1245.8, 9: 1245.8}
     for n, x in card5.items():
         ratio = getattr(lever, next(s.ratio for s in WINDOWS if s.n == n))
-        assert ratio * DRIVE / I == pytest.approx(x, rel=1e-14)
+        assert ratio * DRIVE / INERTIA == pytest.approx(x, rel=1e-14)
 
 
 def refused(**params: float) -> str:
@@ -68,7 +68,7 @@ def test_rule_balance_and_hairspring() -> None:
 
 def test_rule_underdamped_balance() -> None:
     # C = 2 OMEGO = 32.348 1/s: omega1 = sqrt(4 OMEGO^2 - C^2) / 2 is zero (App. A)
-    m = refused(viscous=I * 2 * 16.174)
+    m = refused(viscous=INERTIA * 2 * 16.174)
     assert m.startswith("design rule 'underdamped balance' broken: C = 32.348 1/s")
     assert "expected C < 2 OMEGO" in m
 
@@ -129,7 +129,7 @@ def test_rule_impulse_drives_the_motion() -> None:
 
 def test_rule_lever_gives_net_work() -> None:
     # phase-scheduled: impulse |X3| sin(alpha) + |X4| sin(beta) against the unlock
-    # |X2| (sin(epsilon) - sin(alpha)), per drive torque / I (theta = Theta cos psi)
+    # |X2| (sin(epsilon) - sin(alpha)), per drive torque / INERTIA (theta = Theta cos psi)
     m = refused(impulse_ratio_3=-0.1, impulse_ratio_4=-0.1, unlock_ratio_2=0.9)
     impulse = 0.2 * math.sin(0.2787)
     unlock = 0.9 * (math.sin(0.6338) - math.sin(0.2787))
@@ -151,7 +151,7 @@ def test_violations_lists_every_broken_rule() -> None:
 # -- asymmetric decks against independent solutions ----------------------------------------
 ASYMMETRIC = {
     "beta": 0.25, "gamma": 0.30, "sigma": 0.66,
-    "coulomb_2": I * 320.0, "coulomb_7": -I * 320.0,
+    "coulomb_2": INERTIA * 320.0, "coulomb_7": -INERTIA * 320.0,
     "impulse_ratio_4": -1100.0 / 1245.8, "unlock_ratio_7": -120.0 / 1245.8,
     "impulse_ratio_8": 1200.0 / 1245.8,
 }  # fmt: skip
@@ -169,15 +169,15 @@ def test_phase_scheduled_asymmetric_deck_against_ode_integration() -> None:
     lever = DetachedLever(**ASYMMETRIC)
     lever.initialize(0.0)
     assert len(lever._schedule) == 10  # both impulses change at the dead point
-    c = lever.viscous / I
-    w0sq = lever.stiffness / I
+    c = lever.viscous / INERTIA
+    w0sq = lever.stiffness / INERTIA
     w1 = math.sqrt(w0sq - c * c / 4)
     p = math.pi / 2
     a, b, g, m, e, s = (lever.alpha, lever.beta, lever.gamma, lever.mu, lever.epsilon,
                         lever.sigma)  # fmt: skip
     bounds = [0, p - e, p - a, p, p + b, 2 * p, 3 * p - s, 3 * p - g, 3 * p, 3 * p + m, 4 * p]
     theta, omega, ends = 6.28, 0.0, []
-    for cycle in range(3):
+    for _cycle in range(3):
         for n in range(1, 11):
             f = _forcing(lever, n)
             sol = solve_ivp(
