@@ -63,8 +63,9 @@ def test_the_asymmetric_deck_runs_in_agreement_with_its_reference(tmp_path, fmu_
 
 
 def _nearby(draw: st.DrawFn) -> dict[str, object]:
-    """A deck within 20 % of the worked example's, each window and segment on its own: its
-    cards' signs kept, its angles free enough to cross (a broken order is refused)."""
+    """A deck within 20 % of the worked example's, each window and segment on its own, its
+    angles free enough to cross (a broken order is refused); now and then one card's sign
+    mistyped (refused too)."""
     out: dict[str, object] = {"scene.stop": "4 s"}
     mode = draw(st.sampled_from((0, 1)))
     out["fmus.lever.parameters.switching_mode"] = mode
@@ -75,6 +76,9 @@ def _nearby(draw: st.DrawFn) -> dict[str, object]:
         x = (143.41 if s.ratio.startswith("unlock") else 1245.8) * draw(st.floats(0.8, 1.2))
         sign = -s.direction if s.ratio.startswith("unlock") else s.direction
         out[f"fmus.lever.parameters.{s.ratio}"] = sign * x / 1245.8
+    if draw(st.booleans()):  # a sign mistyped on one card: refused by its rule
+        key = draw(st.sampled_from(sorted(k for k in out if "ratio" in k or "coulomb" in k)))
+        out[key] = -out[key] if out[key] else 1.0
     for name, value in (("alpha", 0.2787), ("beta", 0.2787), ("gamma", 0.2787), ("mu", 0.2787),
                         ("epsilon", 0.6338), ("sigma", 0.6338)):  # fmt: skip
         out[f"fmus.lever.parameters.{name}"] = value * draw(st.floats(0.5, 1.5))
