@@ -5,11 +5,11 @@ University), Ch. III and App. A.  One degree of freedom, the balance angle theta
 
     I theta'' + c theta' + k theta = T_coulomb + T_drive          (Monday 1965, App. A, p. 94)
 
-where the Coulomb torque has constant magnitude and opposes the motion and the drive torque acts
-only in short windows near the dead point: a resisting *unlock* torque and an aiding *impulse*
-torque (Monday 1965, Figs. 2 and 8, pp. 11 and 38; Ch. IV, pp. 39-45).  Within a window the
-right-hand side is constant, so every segment is a linear ODE solved in closed form (Monday 1965,
-Ch. III; App. A, pp. 94-102) and the step needs no numerical integrator.
+where the Coulomb torque opposes the motion and the drive torque acts only in short windows near
+the dead point: a resisting *unlock* torque and an aiding *impulse* torque (Monday 1965, Figs. 2
+and 8, pp. 11 and 38; Ch. IV, pp. 39-45).  Within a window the right-hand side is constant, so
+every segment is a linear ODE solved in closed form (Monday 1965, Ch. III; App. A, pp. 94-102)
+and the step needs no numerical integrator.
 
 Two switching modes (``switching_mode``):
 
@@ -24,14 +24,18 @@ Two switching modes (``switching_mode``):
   are located exactly inside the step.  The period then depends on the drive torque (rate).
 
 Window angles (Monday 1965, Fig. 8, p. 38): moving negative, unlock from +epsilon to +alpha,
-impulse from +alpha to
--beta; moving positive, unlock from -sigma to -gamma, impulse from -gamma to +mu.  After an
-impulse the lever passes to the other side (drop and lock are not modelled).
+impulse from +alpha to -beta; moving positive, unlock from -sigma to -gamma, impulse from -gamma
+to +mu.  After an impulse the lever passes to the other side (drop and lock are not modelled).
 
-The input is the torque the train applies at the escape wheel; the lever transmits it to the
-balance with the ratios ``impulse_ratio`` and ``unlock_ratio`` (balance torque per escape-wheel
-torque).  The defaults make the input the impulse torque at the balance and set the unlock torque
-to the fixture calibration 0.007155/0.06215 of it (Monday 1965, Ch. IV, pp. 39-45).
+Friction and forcing are Monday's deck, per segment of Table III (``detached_lever_design``):
+a Coulomb torque ``coulomb_<n>`` = R(n) I for each of the ten segments, and for each of the six
+windows the balance torque per drive torque (``unlock_ratio_2``, ``impulse_ratio_3``, ...), so
+X(n) = ratio x drive_torque / I.  The input is the torque the train applies at the escape wheel.
+The defaults are the worked example's symmetric deck: the input is the impulse torque at the
+balance and the unlock torque the fixture calibration 0.007155/0.06215 of it (Monday 1965,
+Ch. IV, pp. 39-45).  An impulse whose halves before and after the dead point differ switches
+there; one whose halves are alike is one segment.  A design that breaks a rule of Monday's model
+is refused at initialization (``detached_lever_design.violations``).
 
 The pure functions at the end give the per-cycle amplitude map of the phase-scheduled model
 (derived here from the Table III program: at the cycle end only its A terms survive, so the
@@ -45,7 +49,15 @@ import math
 
 import numpy as np
 
-from .base import COMMON_OUTPUTS, Component, ComponentError, SnapshotPlan, Variable
+from .base import (
+    COMMON_OUTPUTS,
+    Component,
+    ComponentError,
+    SnapshotPlan,
+    Variable,
+    design_parameter,
+)
+from .design_rules import raise_first
 from .detached_lever_data import (
     BALANCE_INERTIA,
     LIFT_ANGLE,
@@ -54,14 +66,20 @@ from .detached_lever_data import (
     UNLOCK_START,
     WORKED_EXAMPLE,
 )
+from .detached_lever_design import (
+    ANGLE_SWITCHED,
+    FREE,
+    IMPULSE,
+    PHASE_SCHEDULED,
+    SEGMENTS,
+    UNLOCK,
+    LeverDesign,
+    segment_variables,
+    symmetric_deck,
+    violations,
+)
 
-PHASE_SCHEDULED = 0
-ANGLE_SWITCHED = 1
-
-# Regime codes.
-FREE = 0
-UNLOCK = 1
-IMPULSE = 2
+# Regime codes: FREE, UNLOCK, IMPULSE (the segment kinds), and
 STOPPED = 3
 REGIME_NAMES = {FREE: "free", UNLOCK: "unlock", IMPULSE: "impulse", STOPPED: "stopped"}
 
@@ -70,6 +88,7 @@ _TWO_PI = 2.0 * math.pi
 
 _WE = WORKED_EXAMPLE
 _I0 = BALANCE_INERTIA
+SEGMENT_VARIABLES = segment_variables()
 
 
 def _flow(
@@ -120,87 +139,34 @@ class DetachedLever(Component):
             min=0.0,
             exclusive_min=True,
         ),
-        Variable(
+        design_parameter(
             "stiffness",
-            "parameter",
             "N.m/rad",
             _I0 * _WE.omega0**2,
-            "hairspring rate K0",
+            "hairspring rate K0 = I OMEGO^2",
+            "Monday: K0",
             min=0.0,
         ),
-        Variable(
-            "viscous", "parameter", "N.m.s/rad", _I0 * _WE.c, "viscous coefficient C.I", min=0.0
+        design_parameter(
+            "viscous", "N.m.s/rad", _I0 * _WE.c, "viscous coefficient C I", "Monday: C", min=0.0
         ),
-        Variable(
-            "coulomb", "parameter", "N.m", _I0 * _WE.r, "kinetic friction torque R.I", min=0.0
-        ),
+        *SEGMENT_VARIABLES[:10],
         # Window angles: within a quarter turn of the dead point (the impulse pin leaves the
         # fork long before; the phase-scheduled model requires it).
-        Variable(
-            "alpha",
-            "parameter",
-            "rad",
-            _WE.alpha,
-            "impulse before dead point, moving -",
-            min=0.0,
-            max=_HALF_PI,
+        *(
+            design_parameter(
+                name, "rad", value, meaning, f"Monday: {symbol}", min=0.0, max=_HALF_PI
+            )
+            for name, value, meaning, symbol in (
+                ("alpha", _WE.alpha, "impulse before dead point, moving -", "ALPHA"),
+                ("beta", _WE.alpha, "impulse after dead point, moving -", "BETA"),
+                ("gamma", _WE.alpha, "impulse before dead point, moving +", "GAMA"),
+                ("mu", _WE.alpha, "impulse after dead point, moving +", "AMU"),
+                ("epsilon", _WE.epsilon, "start of unlock, moving -", "EPIL"),
+                ("sigma", _WE.epsilon, "start of unlock, moving +", "SIGMA"),
+            )
         ),
-        Variable(
-            "beta",
-            "parameter",
-            "rad",
-            _WE.alpha,
-            "impulse after dead point, moving -",
-            min=0.0,
-            max=_HALF_PI,
-        ),
-        Variable(
-            "gamma",
-            "parameter",
-            "rad",
-            _WE.alpha,
-            "impulse before dead point, moving +",
-            min=0.0,
-            max=_HALF_PI,
-        ),
-        Variable(
-            "mu",
-            "parameter",
-            "rad",
-            _WE.alpha,
-            "impulse after dead point, moving +",
-            min=0.0,
-            max=_HALF_PI,
-        ),
-        Variable(
-            "epsilon",
-            "parameter",
-            "rad",
-            _WE.epsilon,
-            "start of unlock, moving -",
-            min=0.0,
-            max=_HALF_PI,
-        ),
-        Variable(
-            "sigma",
-            "parameter",
-            "rad",
-            _WE.epsilon,
-            "start of unlock, moving +",
-            min=0.0,
-            max=_HALF_PI,
-        ),
-        Variable(
-            "impulse_ratio", "parameter", "1", 1.0, "balance torque per drive torque", min=0.0
-        ),
-        Variable(
-            "unlock_ratio",
-            "parameter",
-            "1",
-            _WE.x_unlock / _WE.x_impulse,
-            "resisting balance torque per drive torque while unlocking",
-            min=0.0,
-        ),
+        *SEGMENT_VARIABLES[10:],
         Variable(
             "switching_mode",
             "parameter",
@@ -211,7 +177,9 @@ class DetachedLever(Component):
             min=PHASE_SCHEDULED,
             max=ANGLE_SWITCHED,
         ),
-        Variable("theta_start", "parameter", "rad", _WE.theta0, "initial balance angle"),
+        design_parameter(
+            "theta_start", "rad", _WE.theta0, "initial balance angle", "Monday: THETO"
+        ),
         Variable(
             "overbank_angle",
             "parameter",
@@ -258,38 +226,35 @@ class DetachedLever(Component):
 
     # -- life cycle -------------------------------------------------------------------
     def initialize(self, t0: float) -> None:
-        if self.inertia <= 0.0 or self.stiffness <= 0.0:
-            raise ComponentError("DetachedLever: inertia and stiffness must be positive")
-        if self.viscous < 0.0 or self.coulomb < 0.0:
-            raise ComponentError("DetachedLever: friction must be non-negative")
-        self._w0sq = self.stiffness / self.inertia
-        self._half_c = 0.5 * self.viscous / self.inertia
-        disc = self._w0sq - self._half_c**2
-        if disc <= 0.0:
-            raise ComponentError("DetachedLever: balance is not underdamped (C >= 2 omega0)")
-        self._w1 = math.sqrt(disc)  # Monday 1965, App. A: omega1 = sqrt(4 omega0^2 - C^2)/2
+        self.check_parameters()
         self._mode = int(self.switching_mode)
         if self._mode not in (PHASE_SCHEDULED, ANGLE_SWITCHED):
             raise ComponentError(f"DetachedLever: unknown switching_mode {self._mode}")
+        raise_first(violations(LeverDesign.of(self)))  # a broken design is refused, not run
+        self._w0sq = self.stiffness / self.inertia
+        self._half_c = 0.5 * self.viscous / self.inertia
+        self._w1 = math.sqrt(self._w0sq - self._half_c**2)  # Monday 1965, App. A
+        # Per segment n (Table III): Coulomb torque R(n) I and balance torque per drive torque.
+        # Tuples indexed by n (immutable: shared between snapshots).
+        self._coul = (0.0, *(getattr(self, s.coulomb) for s in SEGMENTS))
+        self._ratio = (0.0, *(getattr(self, s.ratio) if s.ratio else 0.0 for s in SEGMENTS))
+        # The impulse is one segment unless its halves before and after the dead point differ.
+        self._split = frozenset(n for n in (3, 8) if self._forcing_of(n) != self._forcing_of(n + 1))
         a, b, g, m, e, s = self.alpha, self.beta, self.gamma, self.mu, self.epsilon, self.sigma
-        if min(a, b, g, m) < 0.0 or e < a or s < g:
-            raise ComponentError("DetachedLever: need 0 <= alpha <= epsilon, 0 <= gamma <= sigma")
         if self._mode == PHASE_SCHEDULED:
-            if e > _HALF_PI or s > _HALF_PI or b > _HALF_PI or m > _HALF_PI:
-                raise ComponentError("DetachedLever: phase windows must lie within a quarter")
             p = _HALF_PI
-            # (phase at segment end, Coulomb/motion sign d, drive kind), Table III's ten steps.
-            self._schedule = (
-                (p - e, -1, FREE),
-                (p - a, -1, UNLOCK),
-                (p + b, -1, IMPULSE),
-                (2 * p, -1, FREE),
-                (3 * p - s, 1, FREE),
-                (3 * p - g, 1, UNLOCK),
-                (3 * p + m, 1, IMPULSE),
-                (4 * p, 1, FREE),
-            )
+            # (phase at segment end, Coulomb/motion sign d, drive kind, segment), Table III's
+            # ten steps; an impulse whose halves are alike is one step.
+            ends = (p - e, p - a, p, p + b, 2 * p, 3 * p - s, 3 * p - g, 3 * p, 3 * p + m, 4 * p)
+            schedule = []
+            for seg, end in zip(SEGMENTS, ends, strict=True):
+                if seg.n in (4, 9) and seg.n - 1 not in self._split:
+                    schedule[-1] = (end, *schedule[-1][1:])
+                else:
+                    schedule.append((end, seg.direction, seg.kind, seg.n))
+            self._schedule = tuple(schedule)
             self._seg = 0
+            self._segn = 1
             self._cycle_t0 = t0
         self.theta = float(self.theta_start)
         self.omega = float(self.omega_start)
@@ -303,8 +268,7 @@ class DetachedLever(Component):
         self.period = 0.0
         self.cycle_end_angle = self.theta
         if self._mode == PHASE_SCHEDULED:
-            self._dir = self._schedule[0][1]
-            self.regime = FREE
+            _, self._dir, self.regime, self._segn = self._schedule[0]
         else:
             self.lever_side = 1 if self.theta >= 0.0 else -1
             self._dir = int(math.copysign(1.0, self.omega)) if self.omega != 0.0 else 0
@@ -318,52 +282,62 @@ class DetachedLever(Component):
         self._advance(t, t + h, stop_at_beat=False)
 
     # -- forces -----------------------------------------------------------------------
-    def _drive(self, regime: int, d: int) -> float:
-        """Lever torque on the balance for a window regime and motion sign d (Monday, App. A)."""
-        if regime == IMPULSE:
-            return d * self.impulse_ratio * self.drive_torque
-        if regime == UNLOCK:
-            return -d * self.unlock_ratio * self.drive_torque
-        return 0.0
+    def _forcing_of(self, n: int) -> tuple[float, float]:
+        return self._coul[n], self._ratio[n]
+
+    def _drive(self) -> float:
+        """Lever torque on the balance in the current segment, X(n) I (Monday, App. A)."""
+        return self._ratio[self._segn] * self.drive_torque
 
     # -- angle-switched window logic --------------------------------------------------
     def _classify(self) -> None:
-        """Set regime and next target angle from (theta, direction, lever side)."""
+        """Set regime, segment and next target angle from (theta, direction, lever side)."""
         th, d = self.theta, self._dir
         for _ in range(2):
             side = self.lever_side
             if side == 1 and d < 0:
                 if th > self.epsilon:
-                    self.regime, self._target = FREE, self.epsilon
+                    self.regime, self._segn, self._target = FREE, 1, self.epsilon
                 elif th > self.alpha:
-                    self.regime, self._target = UNLOCK, self.alpha
+                    self.regime, self._segn, self._target = UNLOCK, 2, self.alpha
                 elif th > -self.beta:
-                    self.regime, self._target = IMPULSE, -self.beta
+                    self.regime, self._segn, self._target = IMPULSE, 3, -self.beta
+                    if 3 in self._split:  # the impulse changes at the dead point
+                        if th > 0.0:
+                            self._target = 0.0
+                        else:
+                            self._segn = 4
                 else:
                     self.lever_side = -1
                     continue
                 return
             if side == -1 and d > 0:
                 if th < -self.sigma:
-                    self.regime, self._target = FREE, -self.sigma
+                    self.regime, self._segn, self._target = FREE, 6, -self.sigma
                 elif th < -self.gamma:
-                    self.regime, self._target = UNLOCK, -self.gamma
+                    self.regime, self._segn, self._target = UNLOCK, 7, -self.gamma
                 elif th < self.mu:
-                    self.regime, self._target = IMPULSE, self.mu
+                    self.regime, self._segn, self._target = IMPULSE, 8, self.mu
+                    if 8 in self._split:
+                        if th < 0.0:
+                            self._target = 0.0
+                        else:
+                            self._segn = 9
                 else:
                     self.lever_side = 1
                     continue
                 return
             break
-        self.regime, self._target = FREE, math.nan
+        # detached: the free swing after an impulse (or back before an unlock)
+        self.regime, self._segn, self._target = FREE, 5 if d < 0 else 10, math.nan
 
     def _release(self) -> bool:
         """From rest: pick the direction the net torque can move, or stick (Coulomb)."""
         for d in (-1, 1):
             self._dir = d
             self._classify()
-            net = -self.stiffness * self.theta + self._drive(self.regime, d)
-            if net * d > self.coulomb:
+            net = -self.stiffness * self.theta + self._drive()
+            if net * d > abs(self._coul[self._segn]):
                 return True
         self._dir = 0
         self.regime, self._target = STOPPED, math.nan
@@ -380,8 +354,10 @@ class DetachedLever(Component):
                     t = t_end
                     break
             d = self._dir
-            m_drive = self._drive(self.regime, d)
-            t_coul = -d * self.coulomb
+            m_drive = self._drive()
+            # R(n) I: phase-scheduled, signed by the nominal phase as Table III has it;
+            # angle-switched, opposing the actual motion (the segment follows the motion)
+            t_coul = self._coul[self._segn]
             f = (m_drive + t_coul) / inertia
             th0, v0 = self.theta, self.omega
             x0 = th0 - f / w0sq
@@ -419,8 +395,8 @@ class DetachedLever(Component):
                 if not phase:
                     self._dir = -d
                     self._classify()
-                    net = -self.stiffness * th + self._drive(self.regime, -d)
-                    if net * -d <= self.coulomb:
+                    net = -self.stiffness * th + self._drive()
+                    if net * -d <= abs(self._coul[self._segn]):
                         self._release()
                 if stop_at_beat:
                     break
@@ -467,7 +443,7 @@ class DetachedLever(Component):
             self._cycle_t0 += _TWO_PI / self._w1
             self.cycle_count += 1
             self.cycle_end_angle = self.theta
-        _, self._dir, self.regime = self._schedule[self._seg]
+        _, self._dir, self.regime, self._segn = self._schedule[self._seg]
 
     def _account(
         self, th0: float, v0: float, th: float, v: float, m_drive: float, t_coul: float
@@ -522,12 +498,31 @@ def phase_cycle_map(
     mu: float | None = None,
     sigma: float | None = None,
 ) -> tuple[float, float]:
-    """(ratio, offset) of Theta_{n+1} = ratio Theta_n + offset for one phase cycle.
+    """(ratio, offset) of Theta_{n+1} = ratio Theta_n + offset for one phase cycle of a
+    symmetric deck.
 
     All forcing terms are magnitudes per unit inertia [1/s^2]: Coulomb r, unlock x_unlock,
     impulse x_impulse; c [1/s] is the viscous coefficient per unit inertia.  Omitted angles take
     the symmetric values beta = gamma = mu = alpha and sigma = epsilon.
     """
+    f = (r, r + x_unlock, r - x_impulse, r - x_impulse, r, -r, -r - x_unlock,
+         -r + x_impulse, -r + x_impulse, -r)  # fmt: skip
+    return deck_cycle_map(c, omega0, f, alpha, epsilon, beta, gamma, mu, sigma)
+
+
+def deck_cycle_map(
+    c: float,
+    omega0: float,
+    forcing: tuple[float, ...],
+    alpha: float,
+    epsilon: float,
+    beta: float | None = None,
+    gamma: float | None = None,
+    mu: float | None = None,
+    sigma: float | None = None,
+) -> tuple[float, float]:
+    """(ratio, offset) of the cycle map for any deck: ``forcing`` is F(n) = R(n) + X(n) of the
+    ten segments [1/s^2], signed as Monday's cards (Table III, p. 112)."""
     beta = alpha if beta is None else beta
     gamma = alpha if gamma is None else gamma
     mu = alpha if mu is None else mu
@@ -536,8 +531,7 @@ def phase_cycle_map(
     b = c / (2.0 * w1)
     p = _HALF_PI
     w0sq = omega0**2
-    f = (r, r + x_unlock, r - x_impulse, r - x_impulse, r, -r, -r - x_unlock,
-         -r + x_impulse, -r + x_impulse, -r)  # fmt: skip
+    f = forcing
     ph = (p - epsilon, p - alpha, p, p + beta, 2 * p, 3 * p - sigma, 3 * p - gamma, 3 * p,
           3 * p + mu)  # fmt: skip
     const = sum(
@@ -548,14 +542,26 @@ def phase_cycle_map(
     return ratio, const + f[-1] / w0sq - ratio * f[0] / w0sq
 
 
-def phase_amplitudes(theta0: float, n_cycles: int, **map_args: float) -> np.ndarray:
-    """Cycle-end amplitudes Theta_0..Theta_n of the phase-scheduled model (Table III output)."""
-    ratio, offset = phase_cycle_map(**map_args)
+def deck_amplitudes(
+    theta0: float, n_cycles: int, **map_args: float | tuple[float, ...]
+) -> np.ndarray:
+    """Cycle-end amplitudes Theta_0..Theta_n of the phase-scheduled model for any deck."""
+    ratio, offset = deck_cycle_map(**map_args)
+    return _iterate(theta0, n_cycles, ratio, offset)
+
+
+def _iterate(theta0: float, n_cycles: int, ratio: float, offset: float) -> np.ndarray:
     out = np.empty(n_cycles + 1)
     out[0] = theta0
     for n in range(n_cycles):
         out[n + 1] = ratio * out[n] + offset
     return out
+
+
+def phase_amplitudes(theta0: float, n_cycles: int, **map_args: float) -> np.ndarray:
+    """Cycle-end amplitudes Theta_0..Theta_n of the phase-scheduled model (Table III output)."""
+    ratio, offset = phase_cycle_map(**map_args)
+    return _iterate(theta0, n_cycles, ratio, offset)
 
 
 def unit_curve(
@@ -646,19 +652,26 @@ def steady_state(
     return math.nan, math.nan
 
 
-def table_i_params(unit: int, inertia: float = BALANCE_INERTIA) -> dict[str, float]:
-    """Component parameters for a Table I unit (symmetric angles; friction set separately)."""
+def table_i_params(
+    unit: int, inertia: float = BALANCE_INERTIA, coulomb: float = 0.0
+) -> dict[str, float]:
+    """Component parameters for a Table I unit: symmetric angles, the Coulomb torque [N.m] in
+    every segment, impulse ratio 1 and the unit's X2/X3 in the unlock windows."""
     u = TABLE_I[unit]
     a, e = u.alpha, u.epsilon
     return {
         "inertia": inertia,
         "stiffness": inertia * u.omega0**2,
         "viscous": inertia * u.c_over_omega0 * u.omega0,
-        "coulomb": 0.0,
         "alpha": a, "beta": a, "gamma": a, "mu": a, "epsilon": e, "sigma": e,
-        "impulse_ratio": 1.0,
-        "unlock_ratio": u.rows[0].x_unlock / u.rows[0].x_impulse,
+        **symmetric_deck(coulomb, 1.0, table_i_unlock_ratio(unit)),
     }  # fmt: skip
+
+
+def table_i_unlock_ratio(unit: int) -> float:
+    """Unlock torque per impulse torque, X2/X3 of a Table I unit's first load (p. 56)."""
+    row = TABLE_I[unit].rows[0]
+    return row.x_unlock / row.x_impulse
 
 
 def table_i_phase_steady(unit: int) -> list[float]:
@@ -697,19 +710,18 @@ def table_i_angle_switched_fit(unit: int, inertia: float = BALANCE_INERTIA) -> t
     from scipy.optimize import least_squares  # not at module level: the FMU packs numpy only
 
     u = TABLE_I[unit]
-    params = table_i_params(unit, inertia)
     targets = np.array(table_i_phase_steady(unit))
     loads = np.array([row.load_multiple for row in u.rows], dtype=float)
     scale = inertia * u.omega0**2  # fit in units of torque / (I omega0^2), i.e. radians
 
     def residual(z: np.ndarray) -> np.ndarray:
-        p = {**params, "coulomb": abs(z[0]) * scale}
+        p = table_i_params(unit, inertia, abs(z[0]) * scale)
         amps = [steady_state(p, abs(z[1]) * scale * m)[0] for m in loads]
         return np.array([3.0 if a != a else a - t for a, t in zip(amps, targets, strict=True)])
 
     # start: viscous-only energy balance at the middle load, per half swing (as in the cycle map)
     a, e, cw = u.alpha, u.epsilon, u.c_over_omega0
-    work_per_x = 2.0 * a - params["unlock_ratio"] * (e - a)
+    work_per_x = 2.0 * a - table_i_unlock_ratio(unit) * (e - a)
     x0 = 0.5 * math.pi * cw * targets[1] ** 2 / work_per_x / loads[1]
     sol = least_squares(residual, [0.01, x0], x_scale=[0.1, x0], diff_step=1e-6)
     return abs(sol.x[0]) * scale, abs(sol.x[1]) * scale
@@ -721,6 +733,6 @@ def table_i_rate_curve(
     """Steady amplitude [rad] and period [s] of the angle-switched model against load multiple
     for a Table I unit, with the refitted friction and drive of ``table_i_angle_switched_fit``."""
     coulomb, per_load = table_i_angle_switched_fit(unit, inertia)
-    params = {**table_i_params(unit, inertia), "coulomb": coulomb}
+    params = table_i_params(unit, inertia, coulomb)
     res = [steady_state(params, per_load * m) for m in np.asarray(load_multiples, float)]
     return np.array([r[0] for r in res]), np.array([r[1] for r in res])

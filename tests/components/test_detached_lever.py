@@ -27,6 +27,7 @@ from components.detached_lever import (
     unit_curve_steady,
 )
 from components.detached_lever_data import TABLE_I, WORKED_EXAMPLE
+from components.detached_lever_design import symmetric_friction
 
 WE = WORKED_EXAMPLE
 WE_MAP = dict(
@@ -144,7 +145,7 @@ def test_phase_mode_period_independent_of_drive() -> None:
 
 def test_state_restore_bit_identical() -> None:
     for mode in (PHASE_SCHEDULED, ANGLE_SWITCHED):
-        lever = DetachedLever(switching_mode=mode, coulomb=1e-7)
+        lever = DetachedLever(switching_mode=mode, **symmetric_friction(1e-7))
         lever.initialize(0.0)
         lever.step(0.0, 0.137)
         snap = lever.get_state()
@@ -158,8 +159,11 @@ def test_state_restore_bit_identical() -> None:
 def _reference_angle_switched(lever: DetachedLever, t_end: float) -> tuple[float, float, float]:
     """solve_ivp with terminal events at the window angles and reversals: an independent check
     of the closed-form segments (symmetric escapement, released at rest from +theta_start)."""
-    i, k, c, tc = lever.inertia, lever.stiffness, lever.viscous, lever.coulomb
-    m_imp, m_unl = lever.drive_torque * lever.impulse_ratio, lever.drive_torque * lever.unlock_ratio
+    i, k, c, tc = lever.inertia, lever.stiffness, lever.viscous, lever.coulomb_1
+    m_imp, m_unl = (
+        lever.drive_torque * lever.impulse_ratio_8,
+        lever.drive_torque * lever.unlock_ratio_2,
+    )
     a, e = lever.alpha, lever.epsilon
 
     def zone(th: float, d: int, side: int) -> tuple[float, float | None] | None:
@@ -217,7 +221,9 @@ def _reference_angle_switched(lever: DetachedLever, t_end: float) -> tuple[float
 
 
 def test_angle_switched_against_ode_reference() -> None:
-    lever = DetachedLever(switching_mode=ANGLE_SWITCHED, coulomb=2e-7, theta_start=3.0)
+    lever = DetachedLever(
+        switching_mode=ANGLE_SWITCHED, **symmetric_friction(2e-7), theta_start=3.0
+    )
     lever.initialize(0.0)
     lever.step(0.0, 1.3)
     th, v, diss = _reference_angle_switched(lever, 1.3)
@@ -227,10 +233,10 @@ def test_angle_switched_against_ode_reference() -> None:
 
 
 def test_angle_switched_events_and_energy() -> None:
-    lever = DetachedLever(switching_mode=ANGLE_SWITCHED, coulomb=0.0, theta_start=3.0)
+    lever = DetachedLever(switching_mode=ANGLE_SWITCHED, **symmetric_friction(0.0), theta_start=3.0)
     lever.initialize(0.0)
     e0 = lever.stored_energy
-    fine = DetachedLever(switching_mode=ANGLE_SWITCHED, coulomb=0.0, theta_start=3.0)
+    fine = DetachedLever(switching_mode=ANGLE_SWITCHED, **symmetric_friction(0.0), theta_start=3.0)
     fine.initialize(0.0)
     seen = set()
     t = 0.0
@@ -248,7 +254,7 @@ def test_angle_switched_events_and_energy() -> None:
 
 
 def test_overbank_flag() -> None:
-    lever = DetachedLever(switching_mode=ANGLE_SWITCHED, coulomb=0.0, theta_start=3.0)
+    lever = DetachedLever(switching_mode=ANGLE_SWITCHED, **symmetric_friction(0.0), theta_start=3.0)
     lever.drive_torque *= 3.0
     lever.initialize(0.0)
     lever.step(0.0, 0.5)
@@ -263,20 +269,22 @@ def test_angle_switched_sticks_under_large_coulomb() -> None:
     lever.step(0.0, 3.0)
     assert lever.regime == STOPPED
     theta = lever.theta
-    assert abs(lever.stiffness * theta) <= lever.coulomb
+    assert abs(lever.stiffness * theta) <= lever.coulomb_1
     lever.step(3.0, 1.0)
     assert lever.theta == theta and lever.omega == 0.0
 
 
 def test_angle_switched_rate_depends_on_drive() -> None:
-    params = {"coulomb": 0.0}
+    params = symmetric_friction(0.0)
     base = DetachedLever().drive_torque * 0.2
     res = [steady_state(params, base * s) for s in (0.5, 1.0, 2.0, 4.0)]
     amps, periods = zip(*res, strict=True)
     assert all(np.diff(amps) > 0)
     assert np.ptp(periods) > 1e-4  # rate varies with torque (not in the phase model)
     # the steady cycle repeats itself when run by the component
-    lever = DetachedLever(switching_mode=ANGLE_SWITCHED, coulomb=0.0, theta_start=amps[1])
+    lever = DetachedLever(
+        switching_mode=ANGLE_SWITCHED, **symmetric_friction(0.0), theta_start=amps[1]
+    )
     lever.drive_torque = base
     lever.initialize(0.0)
     t = 0.0

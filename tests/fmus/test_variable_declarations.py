@@ -23,6 +23,7 @@ from typing import Any
 import pytest
 
 from components.base import Component, Variable
+from components.detached_lever_design import symmetric_friction
 from fmus.registry import FMU_RECORDS
 from orchestrator.units import to_si
 
@@ -329,7 +330,7 @@ FEEDTHROUGH_CASES: dict[str, tuple[Callable[[], list[tuple[str, Component]]], di
             "DetachedLever",
             ("start", {}, {}, 0, 0.0),
             ("phase-scheduled", {}, {}, 10, 1e-2),
-            ("angle-switched", {"switching_mode": 1, "coulomb": 0.0}, {}, 10, 1e-2),
+            ("angle-switched", {"switching_mode": 1, **symmetric_friction(0.0)}, {}, 10, 1e-2),
         ),
         {"drive_torque": 1e-5},
     ),

@@ -12,6 +12,7 @@ import pytest
 
 from components.detached_lever import DetachedLever
 from components.detached_lever_data import TABLE_I
+from components.detached_lever_design import symmetric_friction
 from orchestrator.errors import ScenarioError
 from orchestrator.run import RunResult, run_scene
 from orchestrator.scenario import load_scene
@@ -33,6 +34,11 @@ WORKED_PERIOD = 0.388603  # s, 2 pi / omega1 of the deck
 _DECK = DetachedLever()
 K, INERTIA = _DECK.stiffness, _DECK.inertia
 OMEGA0 = math.sqrt(K / INERTIA)
+
+
+def friction(coulomb: float) -> dict[str, float]:
+    """Scene overrides of one Coulomb torque in every segment (signed as Monday's cards)."""
+    return {f"fmus.lever.parameters.{k}": v for k, v in symmetric_friction(coulomb).items()}
 
 
 def run(path: Path, out: Path, cache: Path, **overrides) -> RunResult:
@@ -92,7 +98,7 @@ def test_worked_example_against_reference_and_energy(decay: RunResult) -> None:
 def test_thesis_deck_does_not_transfer_to_the_physical_model(tmp_path, fmu_cache) -> None:
     r = run(DECAY_ANGLE, tmp_path, fmu_cache)
     # R = 305.546 s^-2 holds the balance wherever |theta| <= R / omega0^2 = 1.168 rad
-    hold = _DECK.coulomb / K
+    hold = _DECK.coulomb_1 / K
     assert hold == pytest.approx(305.546 / 16.174**2, rel=1e-12)
     assert r.value("stopped") == 1 and r.value("beats") == 3
     assert r.value("amplitude_cycle_1") > hold > r.value("amplitude_cycle_2")
@@ -105,7 +111,7 @@ def test_free_damped_balance(tmp_path, fmu_cache) -> None:
     # No drive and no Coulomb friction: a damped free oscillation, period 2 pi / omega1 and
     # amplitude ratio exp(-pi C / omega1) per cycle, C = c / I.
     r = run(DECAY_ANGLE, tmp_path, fmu_cache, **{"fmus.lever.inputs.drive_torque": 0.0,
-                                                 "fmus.lever.parameters.coulomb": 0.0})  # fmt: skip
+                                                 **friction(0.0)})  # fmt: skip
     c = _DECK.viscous / INERTIA
     omega1 = math.sqrt(OMEGA0**2 - 0.25 * c * c)
     for k in (1, 2, 3):
@@ -122,7 +128,7 @@ def test_coulomb_only_balance(tmp_path, fmu_cache) -> None:
     # 6.28, -5.28, 4.28, -3.28, 2.28, -1.28, 0.28.
     r = run(DECAY_ANGLE, tmp_path, fmu_cache, **{"fmus.lever.inputs.drive_torque": 0.0,
             "fmus.lever.parameters.viscous": 0.0,
-            "fmus.lever.parameters.coulomb": 0.5 * K})  # fmt: skip
+            **friction(0.5 * K)})  # fmt: skip
     assert r.value("beats") == 6 and r.value("stopped") == 1
     for k, expected in ((1, 4.28), (2, 2.28), (3, 0.28)):
         assert r.value(f"amplitude_cycle_{k}") == pytest.approx(expected, abs=1e-12)
@@ -136,7 +142,7 @@ def exact_steady_undamped(coulomb: float, drive: float) -> tuple[float, float]:
     loss, 2 R A = T_i (alpha + beta) - T_u (epsilon - alpha); each window is a harmonic arc
     about its shifted centre M / k, timed by arccos."""
     d = _DECK
-    t_imp, t_unl = d.impulse_ratio * drive, d.unlock_ratio * drive
+    t_imp, t_unl = d.impulse_ratio_8 * drive, d.unlock_ratio_2 * drive
     amp = (2 * d.alpha * t_imp - (d.epsilon - d.alpha) * t_unl) / (2 * coulomb)
     x, v2, t = amp, 0.0, 0.0  # v2 = (speed / omega0)^2; moving negative from +amp
     windows = ((d.epsilon, coulomb), (d.alpha, coulomb + t_unl), (-d.alpha, coulomb - t_imp))
@@ -162,7 +168,7 @@ def test_angle_switched_rate_against_exact_steady_state(tmp_path, fmu_cache) -> 
         r = run(DECAY_ANGLE, tmp_path / str(n), fmu_cache, **{
             "fmus.lever.inputs.drive_torque": drive,
             "fmus.lever.parameters.viscous": 0.0,
-            "fmus.lever.parameters.coulomb": coulomb,
+            **friction(coulomb),
             "fmus.lever.parameters.theta_start": amp,
         })  # fmt: skip
         # released on the steady cycle, it stays there (5 cycles in 2 s)

@@ -17,6 +17,8 @@ FAMILY = SceneFamily(
             ),
         ),
     ),
+    design_check="orchestrator.scenes.detached_lever.design:check",
+    drawing="orchestrator.scenes.detached_lever.drawing:draw",
     analysis="orchestrator.scenes.detached_lever.report:analyse",
     plot="orchestrator.scenes.detached_lever.report:plot",
     reference="orchestrator.scenes.detached_lever.report:reference",

@@ -6,8 +6,10 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 from components.detached_lever_data import TABLE_I
+from components.detached_lever_design import SEGMENTS
 from orchestrator.errors import ScenarioError
 from orchestrator.scenario import Scene
 from orchestrator.units import to_si
@@ -49,16 +51,19 @@ class LeverScene:
     def nominal_period(self) -> float:
         return self.nominal if self.nominal is not None else self.free_period
 
-    def map_args(self) -> dict[str, float]:
-        """Arguments of ``phase_cycle_map``: the deck per unit inertia (Monday 1965, pp. 39-45)."""
+    def map_args(self) -> dict[str, Any]:
+        """Arguments of ``deck_cycle_map``: the deck per unit inertia, F(n) = R(n) + X(n) of
+        each segment (Monday 1965, Table III, p. 112)."""
         p = self.params
         i = p["inertia"]
+        forcing = tuple(
+            p[s.coulomb] / i + (p[s.ratio] * self.drive_torque / i if s.ratio else 0.0)
+            for s in SEGMENTS
+        )
         return {
             "c": p["viscous"] / i,
             "omega0": math.sqrt(p["stiffness"] / i),
-            "r": p["coulomb"] / i,
-            "x_unlock": p["unlock_ratio"] * self.drive_torque / i,
-            "x_impulse": p["impulse_ratio"] * self.drive_torque / i,
+            "forcing": forcing,
             "alpha": p["alpha"],
             "epsilon": p["epsilon"],
             "beta": p["beta"],

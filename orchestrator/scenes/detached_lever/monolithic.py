@@ -1,5 +1,6 @@
 """The angle-switched detached lever (Monday 1965) run from extreme to extreme by its own
-closed-form segments, without macro steps: the yardstick of a coupled run."""
+closed-form segments, without macro steps: the yardstick of a coupled run.  It takes the
+scene's whole deck, each segment's friction R(n) and each window's forcing X(n) as given."""
 
 from __future__ import annotations
 

@@ -35,8 +35,8 @@ from components.detached_lever import (
     ANGLE_SWITCHED,
     PHASE_SCHEDULED,
     STOPPED,
-    phase_amplitudes,
-    phase_cycle_map,
+    deck_amplitudes,
+    deck_cycle_map,
     steady_state,
     unit_curve,
     unit_curve_steady,
@@ -231,8 +231,8 @@ def reference(scene: Scene) -> Reference:
         w1 = lever.omega1
         n_cycles = int(math.floor((lever.stop - lever.start) * w1 / (2.0 * math.pi)))
         args = lever.map_args()
-        amps = phase_amplitudes(lever.params["theta_start"], n_cycles, **args)
-        ratio, offset = phase_cycle_map(**args)
+        amps = deck_amplitudes(lever.params["theta_start"], n_cycles, **args)
+        ratio, offset = deck_cycle_map(**args)
         for k in NAMED_CYCLES:
             if k <= n_cycles:
                 headline[f"amplitude_cycle_{k}"] = float(amps[k])
@@ -317,8 +317,8 @@ def plot(scene: Scene, header: list[str], data: np.ndarray, path: Path) -> None:
         steady = unit_curve_steady(cw, k_cuc)
         label = f"thesis computed unit curve, unit {unit}, K = {k_cuc:.3f}"
     else:
-        thesis = phase_amplitudes(p["theta_start"], n_map, **lever.map_args())
-        ratio, offset = phase_cycle_map(**lever.map_args())
+        thesis = deck_amplitudes(p["theta_start"], n_map, **lever.map_args())
+        ratio, offset = deck_cycle_map(**lever.map_args())
         steady = offset / (1.0 - ratio) if ratio < 1.0 else math.nan  # undamped: no limit
         label = "thesis cycle map (Table III), same deck"
     ax.plot(np.arange(n_map + 1), thesis, "-", color="C2", lw=1.0, label=label)
