@@ -158,7 +158,7 @@ def test_the_single_pass_takes_no_longest_step_of_its_own(overrides: dict, longe
     try:
         system.initialize(fmu_tolerance(system, scene))
         master = regime_aware(system, scene, StepStats())
-        assert master.cfg.longest_step == pytest.approx(longest, rel=1e-12)
+        assert master.settings.longest_step == pytest.approx(longest, rel=1e-12)
     finally:
         system.close()
 
@@ -176,7 +176,8 @@ def test_error_scales_start_at_the_declared_nominals() -> None:
         system.initialize()
         master = regime_aware(system, scene, StepStats())
         scales = {
-            (system.names[i], system.real_names[i][k]): v for (i, k), v in master.out_scale.items()
+            (system.names[i], system.real_names[i][k]): v
+            for (i, k), v in master.scheme.held.out_scale.items()
         }
         assert scales == {
             ("drive", "angle"): 1.0,
@@ -205,9 +206,10 @@ def test_the_midpoint_hold_ramps_the_inputs_whose_receivers_take_a_rate(
     try:
         system.initialize()
         master = regime_aware(system, scene, StepStats())
-        assert {system.names[j] for j, _, _ in master.ramps} == ramped
-        for j, k, _ in master.ramps:
-            (source, slot), averaged = master.held_inputs[j][k]
+        ramps = master.scheme.ramps
+        assert {system.names[j] for j, _, _ in ramps} == ramped
+        for j, k, _ in ramps:
+            (source, slot), averaged, _ = master.scheme.held.inputs[j][k]
             assert averaged and system.real_names[source][slot] == "torque"
     finally:
         system.close()
