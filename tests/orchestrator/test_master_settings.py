@@ -15,6 +15,7 @@ from orchestrator.master_settings import (
     FixedStepSettings,
     MasterStepControl,
     RegimeAwareSettings,
+    SinglePassControl,
 )
 from orchestrator.masters import MASTERS, TOLERANCE_MASTERS
 from orchestrator.scenario import load_scene
@@ -55,6 +56,15 @@ def test_step_control_factors() -> None:
     assert c.shrink(1e9, False) == c.max_shrink
     assert c.grow(0.8, False) == pytest.approx(1.0)
     assert c.shrink(0.9 * 2.0, True) == pytest.approx(0.5)
+    # The single pass grows its steps a safety factor less than the estimate allows.
+    assert c.grow(0.8, False, safety=0.8) == pytest.approx(0.8)
+    assert c.grow(0.0, False, safety=0.8) == c.max_growth
+
+
+def test_the_single_pass_asks_its_fmus_for_a_tenth_of_its_tolerance_at_most_1e_5() -> None:
+    c = SinglePassControl()
+    assert c.fmu_tolerance(1e-5) == pytest.approx(1e-6, rel=1e-15)
+    assert c.fmu_tolerance(2e-4) == 1e-5
 
 
 @pytest.mark.parametrize(
