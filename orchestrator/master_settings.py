@@ -81,9 +81,7 @@ class MasterStepControl:
     jump_ratio: float = 0.5  # "as large": the ratio fell by less than this factor
     event_time_slack: float = 1e-12  # relative: a reported event time this past the end counts
     settle_window: float = 10.0  # switches within this many event tolerances: one instant
-    # Midpoint hold, after a switch into regimes where every accepted step had zero coupling
-    # error (a verge in free flight): restart at this fraction of the step proposed there, as
-    # the next switch is usually nearer than the whole step and a ramp-up buys nothing.
+    # Midpoint hold: restart in regimes of zero coupling error at this fraction of their step.
     zero_error_restart: float = 0.25
 
     def factor(self, ratio: float, first_order: bool) -> float:
@@ -110,22 +108,19 @@ class SinglePassControl:
     """The single pass's own constants (masters/single_pass.py), each with its reason (the
     measurements behind them: docs/measurements.md)."""
 
-    # A step grows this much less than its estimate allows: a pass too long is retaken whole.
+    # The next step is this times what the estimate allows: a too long pass is retaken whole.
     growth_safety: float = 0.8
-    # After a switch, this fraction of the step proposed last in the regimes entered: a ramp
-    # up from master.first_step costs passes, a too long restart only one.
+    # Restart after a switch at this fraction of the last step proposed in the regimes entered.
     restart: float = 0.25
-    # Previous points of the input extrapolation (1: linear); quadratic took fewer steps but
-    # made the error several times larger.
+    # Previous points of the input extrapolation: linear; quadratic had several times the error.
     extrapolation_points: int = 1
-    # Passes over one step when FMUs that end early stop before one another.
+    # Passes over one step when FMUs that end at their first event stop before one another.
     early_return_rounds: int = 4
-    # A copied source's travel in a step counts as at least this fraction of its travel at
-    # its largest rate so far: a source at rest would otherwise allow no mismatch at all.
+    # A copied source travels at least this fraction of its fastest travel (one at rest too).
     travel_floor: float = 0.1
-    # The FMUs integrate to this fraction of the coupling tolerance, at most
-    # fmu_tolerance_max: their error stays below the coupling error, not far below it.
+    # FMUs integrate to this fraction of the coupling tolerance: below its error, not far below.
     fmu_tolerance_fraction: float = 0.1
+    # ... at most this: integrated at 5e-5 or looser the escapement leaves its path.
     fmu_tolerance_max: float = 1e-5
 
     def fmu_tolerance(self, tolerance: float) -> float:
