@@ -69,6 +69,9 @@ class MidpointTrials:
     """Predictor (and with the midpoint hold, corrector) trials; see the module doc."""
 
     growth_safety = 1.0  # the estimate's own safety factor suffices
+    #: none: after a step of master.min_step onto an impact the held-start estimate may
+    #: propose a shorter one (M739 under the start hold: 2e-15 s)
+    next_step_floor = 0.0
 
     def __init__(
         self,

@@ -71,6 +71,7 @@ class TrialScheme(Protocol):
     """How trial steps are taken and judged (the midpoint hold, the single pass)."""
 
     growth_safety: float  # the step grows this much less than the estimate allows
+    next_step_floor: float  # the shortest step proposed after an accepted one
     restart: RestartSteps  # the step after a switch
 
     def begin(self, start: StepStart) -> None:
@@ -156,7 +157,7 @@ class RegimeAwareMaster:
             scheme.accepted(start)
             self.guard.note_changes(before)
             grown = h * cfg.control.grow(ratio, first_order, scheme.growth_safety)
-            self.h = min(cfg.longest_step, max(cfg.min_step, grown))
+            self.h = min(cfg.longest_step, max(scheme.next_step_floor, grown))
             scheme.restart.remember(tuple(before.regimes), ratio, self.h)
             self.guard.smooth_step()
             # A regime that changed without a located switch changed at the step start.

@@ -83,6 +83,7 @@ class SinglePassTrials:
         self.system, self.settings, self.stats, self.landing = system, settings, stats, landing
         control = settings.single_pass_control
         self.growth_safety = control.growth_safety
+        self.next_step_floor = settings.min_step
         self.rounds = control.early_return_rounds
         self.travel_floor = control.travel_floor
         self.restart = RestartSteps(settings.first_step, control.restart, False)
