@@ -69,7 +69,8 @@ class FixedStepSettings:
 
 @dataclass(frozen=True)
 class MasterStepControl:
-    """The regime-aware master's step-size controller: its constants, named."""
+    """The regime-aware master's step-size controller: its constants, named, each with the
+    reason for its value (the measurements behind them: docs/measurements.md)."""
 
     max_growth: float = 4.0  # largest factor a step grows by after an accepted one
     max_shrink: float = 0.2  # smallest factor a rejected step shrinks by
@@ -80,11 +81,7 @@ class MasterStepControl:
     jump_ratio: float = 0.5  # "as large": the ratio fell by less than this factor
     event_time_slack: float = 1e-12  # relative: a reported event time this past the end counts
     settle_window: float = 10.0  # switches within this many event tolerances: one instant
-    # After a switch into regimes where every accepted step so far had zero coupling error
-    # (nothing the held inputs reach is exchanged, e.g. a verge in free flight), the restart
-    # is this fraction of the step proposed there last: a ramp up from master.first_step
-    # buys nothing where the error is zero, and the next switch is usually nearer than the
-    # whole step (the measurements: docs/measurements.md).
+    # Midpoint hold: restart in regimes of zero coupling error at this fraction of their step.
     zero_error_restart: float = 0.25
 
     def factor(self, ratio: float, first_order: bool) -> float:
@@ -98,11 +95,37 @@ class MasterStepControl:
         """Factor for a rejected step (never below ``max_shrink``)."""
         return max(self.max_shrink, self.factor(ratio, first_order))
 
-    def grow(self, ratio: float, first_order: bool) -> float:
-        """Factor for the step after an accepted one (between the two bounds)."""
+    def grow(self, ratio: float, first_order: bool, safety: float = 1.0) -> float:
+        """Factor for the step after an accepted one (between the two bounds), ``safety``
+        times less than the estimate allows."""
         if ratio == 0.0:
             return self.max_growth
-        return min(self.max_growth, self.shrink(ratio, first_order))
+        return min(self.max_growth, self.shrink(ratio, first_order) * safety)
+
+
+@dataclass(frozen=True)
+class SinglePassControl:
+    """The single pass's own constants (masters/single_pass.py), each with its reason (the
+    measurements behind them: docs/measurements.md)."""
+
+    # The next step is this times what the estimate allows: a too long pass is retaken whole.
+    growth_safety: float = 0.8
+    # Restart after a switch at this fraction of the last step proposed in the regimes entered.
+    restart: float = 0.25
+    # Previous points of the input extrapolation: linear; quadratic had several times the error.
+    extrapolation_points: int = 1
+    # Passes over one step when FMUs that end at their first event stop before one another.
+    early_return_rounds: int = 4
+    # A copied source travels at least this fraction of its fastest travel (one at rest too).
+    travel_floor: float = 0.1
+    # FMUs integrate to this fraction of the coupling tolerance: below its error, not far below.
+    fmu_tolerance_fraction: float = 0.1
+    # ... at most this: integrated at 5e-5 or looser the escapement leaves its path.
+    fmu_tolerance_max: float = 1e-5
+
+    def fmu_tolerance(self, tolerance: float) -> float:
+        """The integration tolerance asked of the FMUs for a coupling ``tolerance``."""
+        return min(self.fmu_tolerance_max, self.fmu_tolerance_fraction * tolerance)
 
 
 @dataclass(frozen=True)
@@ -119,6 +142,7 @@ class RegimeAwareSettings:
     max_events_per_step: int = setting(50)  # switches at (nearly) one instant: chattering
     input_hold: str = setting("auto", choices=("auto", "start", "midpoint", "extrapolated"))
     control: MasterStepControl = MasterStepControl()
+    single_pass_control: SinglePassControl = SinglePassControl()
     run_duration: float = math.inf  # not a scene key: the run's length (longest_step)
 
     @property
@@ -132,9 +156,8 @@ class RegimeAwareSettings:
         """master.max_step, else the scheme's own, at most the run: the midpoint hold's
         (and "auto" before it is resolved) 100 first steps; the single pass's the run, as
         its steps end at the first event of an FMU that returns early and its copies'
-        mismatch holds them to the tolerance, so a cap tied to the first step only adds
-        passes (M739 at 1e-3: 1377 doSteps and turns error 8.6e-6, against 2266 and 2.4e-6
-        capped at 100 first steps; the clock train 2055 and 5.7e-5 against 2467 and 9.5e-6)."""
+        mismatch holds them to the tolerance: a cap tied to the first step only adds
+        passes."""
         if self.max_step is not None:
             return self.max_step
         if self.single_pass:

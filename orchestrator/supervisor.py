@@ -17,6 +17,7 @@ from __future__ import annotations
 import codecs
 import contextlib
 import ctypes
+import faulthandler
 import io
 import os
 import signal
@@ -76,6 +77,10 @@ def _child(
 
     code = 1
     inherited = unpacked_files()  # the parent's, left to it
+    # A crash is reported by the parent, from the flight record (the FMU, its FMI call, the
+    # time, the signal): an inherited fault handler (``python -X faulthandler``, pytest's)
+    # would add the child's Python stack, which at an FMU's crash is the master's call.
+    faulthandler.disable()
     try:
         os.setpgid(0, 0)
         _end_with_parent(parent)

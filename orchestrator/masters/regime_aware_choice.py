@@ -8,10 +8,13 @@ from __future__ import annotations
 
 from dataclasses import replace
 
+from orchestrator.masters.copies import judged_by_copies
 from orchestrator.masters.fixed_step import fixed_step_master
 from orchestrator.masters.macro_step import Master
+from orchestrator.masters.midpoint_trial import MidpointTrials
 from orchestrator.masters.regime_aware import RegimeAwareMaster
-from orchestrator.masters.single_pass import SinglePassMaster, judged_by_copies
+from orchestrator.masters.single_pass import SinglePassTrials
+from orchestrator.masters.switches import Landing
 from orchestrator.recorder import StepStats
 from orchestrator.scenario import Scene
 from orchestrator.system import CoupledSystem
@@ -36,20 +39,10 @@ def regime_aware(system: CoupledSystem, scene: Scene, stats: StepStats) -> Maste
         return fixed_step_master(system, scene, stats, scene.master.step, sequential=False)
     settings = replace(scene.master.settings, input_hold=input_hold(system, scene))
     stats.extra["input_hold"] = settings.input_hold
-    algorithm = SinglePassMaster if settings.single_pass else RegimeAwareMaster
-    return algorithm(system, settings, stats)
-
-
-#: The single pass asks its FMUs for this fraction of its own tolerance, at most
-#: FMU_TOLERANCE_MAX: their integration error stays below the coupling error it controls
-#: (M739 at 1e-2: turns error 1.11e-5 against 1.09e-5 at their own 1e-8, about 10 % less
-#: time; the monolithic M739 leaves the escapement's path at 5e-5 and looser).  A tenth,
-#: not a thousandth: the verge's and trains' steps at 1e-4 and 1e-5 were integrated a
-#: hundred times finer than the coupling needs (M739 at 1e-5: 4365 integrator steps against
-#: 5615, 16 % fewer Python calls, turns error 4.6e-7 against 8.1e-7; at 1e-4 3.0e-6 against
-#: 2.3e-6; the clock train 6.1e-6 against 6.7e-6 at 1e-5, 1.45e-5 against 1.22e-5 at 1e-4).
-FMU_TOLERANCE_FRACTION = 1e-1
-FMU_TOLERANCE_MAX = 1e-5
+    landing = Landing.of(settings)
+    trials = SinglePassTrials if settings.single_pass else MidpointTrials
+    scheme = trials(system, settings, stats, landing)
+    return RegimeAwareMaster(system, settings, stats, scheme, landing)
 
 
 def fmu_tolerance(system: CoupledSystem, scene: Scene) -> float | None:
@@ -60,7 +53,7 @@ def fmu_tolerance(system: CoupledSystem, scene: Scene) -> float | None:
     if scene.master.algorithm != "regime-aware" or settings is None:
         return None
     if input_hold(system, scene) == "extrapolated":
-        return min(FMU_TOLERANCE_MAX, FMU_TOLERANCE_FRACTION * settings.tolerance)
+        return settings.single_pass_control.fmu_tolerance(settings.tolerance)
     return None
 
 
@@ -68,7 +61,7 @@ def input_hold(system: CoupledSystem, scene: Scene) -> str:
     """The regime-aware master's ``input_hold`` with "auto" resolved: the single pass
     ("extrapolated") where an FMU's copy of its partner judges the coupling; elsewhere the
     midpoint hold, as the single pass's error test holds steps near the stiffest coupling's
-    stability limit (press feed Run 1 at 1e-3: 4.8x its reference, the midpoint hold 2.2x)."""
+    stability limit (docs/measurements.md: the press feed)."""
     hold = scene.master.settings.input_hold
     if hold != "auto":
         return hold

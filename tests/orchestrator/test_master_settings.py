@@ -15,6 +15,7 @@ from orchestrator.master_settings import (
     FixedStepSettings,
     MasterStepControl,
     RegimeAwareSettings,
+    SinglePassControl,
 )
 from orchestrator.masters import MASTERS, TOLERANCE_MASTERS
 from orchestrator.scenario import load_scene
@@ -55,6 +56,15 @@ def test_step_control_factors() -> None:
     assert c.shrink(1e9, False) == c.max_shrink
     assert c.grow(0.8, False) == pytest.approx(1.0)
     assert c.shrink(0.9 * 2.0, True) == pytest.approx(0.5)
+    # The single pass grows its steps a safety factor less than the estimate allows.
+    assert c.grow(0.8, False, safety=0.8) == pytest.approx(0.8)
+    assert c.grow(0.0, False, safety=0.8) == c.max_growth
+
+
+def test_the_single_pass_asks_its_fmus_for_a_tenth_of_its_tolerance_at_most_1e_5() -> None:
+    c = SinglePassControl()
+    assert c.fmu_tolerance(1e-5) == pytest.approx(1e-6, rel=1e-15)
+    assert c.fmu_tolerance(2e-4) == 1e-5
 
 
 @pytest.mark.parametrize(
@@ -158,7 +168,7 @@ def test_the_single_pass_takes_no_longest_step_of_its_own(overrides: dict, longe
     try:
         system.initialize(fmu_tolerance(system, scene))
         master = regime_aware(system, scene, StepStats())
-        assert master.cfg.longest_step == pytest.approx(longest, rel=1e-12)
+        assert master.settings.longest_step == pytest.approx(longest, rel=1e-12)
     finally:
         system.close()
 
@@ -176,7 +186,8 @@ def test_error_scales_start_at_the_declared_nominals() -> None:
         system.initialize()
         master = regime_aware(system, scene, StepStats())
         scales = {
-            (system.names[i], system.real_names[i][k]): v for (i, k), v in master.out_scale.items()
+            (system.names[i], system.real_names[i][k]): v
+            for (i, k), v in master.scheme.held.out_scale.items()
         }
         assert scales == {
             ("drive", "angle"): 1.0,
@@ -205,9 +216,10 @@ def test_the_midpoint_hold_ramps_the_inputs_whose_receivers_take_a_rate(
     try:
         system.initialize()
         master = regime_aware(system, scene, StepStats())
-        assert {system.names[j] for j, _, _ in master.ramps} == ramped
-        for j, k, _ in master.ramps:
-            (source, slot), averaged = master.held_inputs[j][k]
+        ramps = master.scheme.ramps
+        assert {system.names[j] for j, _, _ in ramps} == ramped
+        for j, k, _ in ramps:
+            (source, slot), averaged, _ = master.scheme.held.inputs[j][k]
             assert averaged and system.real_names[source][slot] == "torque"
     finally:
         system.close()

@@ -189,3 +189,38 @@ def test_two_fmus_switching_at_one_instant_both_switch_there(tmp_path, fmu_cache
     assert [(o, n) for _, o, n in by_fmu["a"]] == [(o, n) for _, o, n in by_fmu["b"]]
     for (ta, _, _), (tb, _, _) in zip(by_fmu["a"], by_fmu["b"], strict=True):
         assert ta == tb  # one landing, both logged at it
+
+
+def test_the_restart_after_a_switch_remembers_per_regimes() -> None:
+    """The midpoint hold remembers the largest step proposed while every step in those
+    regimes had zero coupling error, the single pass the last one proposed; either restarts
+    at a fraction of it, never below master.first_step."""
+    from orchestrator.masters.regime_aware import RestartSteps
+
+    zero_only = RestartSteps(1e-6, 0.25, zero_error_only=True)
+    zero_only.remember((0, 1), 0.0, 8e-5)
+    zero_only.remember((0, 1), 0.0, 4e-5)
+    assert zero_only.step((0, 1)) == 0.25 * 8e-5
+    zero_only.remember((0, 1), 0.5, 1e-4)  # an error: nothing remembered there any more
+    assert zero_only.step((0, 1)) == 1e-6
+    last = RestartSteps(1e-6, 0.25, zero_error_only=False)
+    last.remember((2,), 0.5, 8e-5)
+    last.remember((2,), 0.9, 4e-5)
+    assert last.step((2,)) == 0.25 * 4e-5
+    assert last.step((3,)) == 1e-6
+
+
+def test_a_step_lands_on_a_switch_within_its_window() -> None:
+    """An estimated switch (an indicator's secant) within the event tolerance of the step
+    end; an instant an FMU reported within one instant (10 event tolerances)."""
+    from orchestrator.master_settings import RegimeAwareSettings
+    from orchestrator.masters.switches import Landing, Switch
+
+    landing = Landing.of(RegimeAwareSettings(first_step=1e-6, event_tolerance=1e-10))
+    assert landing.instant == 10 * 1e-10
+    t, h = 0.0, 1e-3
+    assert landing.lands(t, h, Switch(h - 0.5e-10, located=False))
+    assert not landing.lands(t, h, Switch(h - 5e-10, located=False))
+    assert landing.lands(t, h, Switch(h - 5e-10, located=True))
+    assert not landing.lands(t, h, Switch(h - 2e-9, located=True))
+    assert landing.lands(t, 1e-14, Switch(0.0, located=False))  # at min_step: cannot shorten

@@ -3,7 +3,7 @@ together (an angle with its speed) and how."""
 
 from __future__ import annotations
 
-from orchestrator.masters.single_pass import angles_with_speeds
+from orchestrator.masters.copies import angles_with_speeds
 from orchestrator.model_info import base_of_unit_name
 
 RAD, RAD_S = base_of_unit_name("rad"), base_of_unit_name("rad/s")

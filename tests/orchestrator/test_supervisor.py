@@ -60,3 +60,37 @@ def test_an_exit_outside_any_fmi_call_names_the_last_fmu(
         "call": None,
     }
     assert "outside any FMI call (last FMU called: 'gear')" in capsys.readouterr().out
+
+
+CRASH_UNDER_A_FAULT_HANDLER = """
+import os, signal
+from orchestrator.interrupt import catching_signals
+from orchestrator.supervisor import supervised
+
+def work():
+    os.kill(os.getpid(), signal.SIGSEGV)
+    return 0
+
+with catching_signals() as guard:
+    raise SystemExit(supervised(work, guard))
+"""
+
+
+def test_a_crash_under_a_fault_handler_is_reported_once() -> None:
+    """A fault handler the command inherits (``-X faulthandler``, pytest's) does not dump the
+    child's stack: the parent's one-line report is the whole of stderr."""
+    import subprocess
+    import sys
+
+    proc = subprocess.run(
+        [sys.executable, "-X", "faulthandler", "-c", CRASH_UNDER_A_FAULT_HANDLER],
+        cwd=Path(__file__).resolve().parents[2],
+        env={**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[2])},
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert proc.returncode == 1
+    assert proc.stderr == (
+        "error: the command crashed before its run began: killed by SIGSEGV (signal 11)\n"
+    )
