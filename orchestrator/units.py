@@ -31,8 +31,11 @@ def pint_unit(fmi_unit: str) -> pint.Unit:
     return UREG.Unit(expr)
 
 
-def to_si(value: object, fmi_unit: str) -> float:
+def to_si(value: object, fmi_unit: str, exact: bool = False) -> float:
     """A number (taken as already SI) or a string such as '0.4701 in' -> float in fmi_unit.
+
+    ``exact``: a mass in lbf*s^2/in or an inertia in lbf*in*s^2 is converted with the
+    exact pound-force of components.units, as the M739's built-in data are.
 
     Raises ValueError with a message naming the expected unit.
     """
@@ -52,9 +55,9 @@ def to_si(value: object, fmi_unit: str) -> float:
             return float(quantity)
         if quantity.unitless:  # a bare number written as text ("2.5", "nan"): taken as SI
             return float(quantity.magnitude)
-        exact = _EXACT.get(quantity.units)
-        if exact is not None and UREG.Unit(exact[0]) == target:
-            return float(quantity.magnitude) * exact[1]
+        factor = _EXACT.get(quantity.units) if exact else None
+        if factor is not None and UREG.Unit(factor[0]) == target:
+            return float(quantity.magnitude) * factor[1]
         return float(quantity.to(target).magnitude)
     except pint.DimensionalityError:
         hint = (

@@ -61,12 +61,12 @@ def test_the_design_file_in_source_units_gives_the_m739_values_to_the_bit() -> N
     assert set(values) == set(BY_NAME)
     for name, text in values.items():
         e = BY_NAME[name]
-        si = to_si(text, e.unit) if isinstance(text, str) else text
+        si = to_si(text, e.unit, exact=True) if isinstance(text, str) else text
         if name == "spin":  # 30000 rpm: what the M739 scene has always run at
             assert si == pytest.approx(M739.omega, rel=1e-15)
         else:
             assert si == e.default(), name
-    assert data_from({n: to_si(t, BY_NAME[n].unit) for n, t in values.items()}) == M739.with_(
+    assert data_from({n: to_si(t, BY_NAME[n].unit, True) for n, t in values.items()}) == M739.with_(
         rpm=data_from({"spin": to_si("30000 rpm", "rad/s")}).rpm
     )
 

@@ -16,7 +16,8 @@ from orchestrator.cli import main
 from orchestrator.run import run_scene
 from orchestrator.scenario import load_scene
 from orchestrator.scenes.m739.design import scene_design
-from tests.conftest import SCENARIOS
+
+SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
 
 #: matplotlib's "C3", the colour drawing.py gives the pallet faces.
 FACE_RGB = np.array([0xD6, 0x27, 0x28])
