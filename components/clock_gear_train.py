@@ -75,7 +75,10 @@ import math
 from typing import Any
 
 from .base import ComponentError, Variable, common_outputs
+from .clock_train_design import DESIGN_VARIABLES, body_data, clock_train, train_violations
+from .clock_train_design import values_of as design_values
 from .clock_train_kinematics import M739_TRAIN, ClockMesh, ClockTrain
+from .design_rules import raise_first
 from .escape_wheel import (
     ESCAPE_WHEEL_PORT,
     ESCAPE_WHEEL_VARIABLES,
@@ -86,6 +89,7 @@ from .escape_wheel import (
 )
 from .event_integration import INTEGRATION_VARIABLES
 from .m739_data import M739, M739Data
+from .sanda2v_deck import CHECK_DESIGN
 from .train_component import TrainComponent, TrainLoadModel
 
 LOSS_NONE = 0
@@ -140,6 +144,7 @@ class ClockTrainPhysics:
                 f"ClockGearTrain: loss_model {loss_model!r} unknown; expected one of "
                 + ", ".join(f"{k} ({v})" for k, v in LOSS_MODELS.items())
             )
+        self.train = train
         self.meshes: tuple[ClockMesh, ClockMesh] = (train.mesh1, train.mesh2)
         self.kappa2 = train.kappa2
         self.loss_model = int(loss_model)
@@ -530,11 +535,8 @@ class ClockGearTrain(TrainComponent):
     PORTS = {"escape_wheel": ESCAPE_WHEEL_PORT}
 
     VARIABLES = (
-        Variable(
-            "mu", "parameter", "1", M739.mu, "Coulomb friction, mesh contacts and pivots", min=0.0
-        ),
-        # The model takes |omega| (spin in either sense gives the same motion): spin >= 0.
-        Variable("spin", "parameter", "rad/s", M739.omega, "fuze spin rate omega", min=0.0),
+        *DESIGN_VARIABLES,
+        CHECK_DESIGN,
         Variable(
             "loss_model",
             "parameter",
@@ -617,9 +619,13 @@ class ClockGearTrain(TrainComponent):
         self._start_integration()
         if self.pivot_loads not in (0.0, 1.0):
             raise ComponentError("ClockGearTrain: pivot_loads must be 0 or 1")
+        values = design_values(self)
+        train = clock_train(values)
+        if self.check_design:
+            raise_first(train_violations(train))
         self._phys = ClockTrainPhysics(
-            M739_TRAIN,
-            M739,
+            train,
+            body_data(values),
             mu=self.mu,
             omega=self.spin,
             loss_model=int(self.loss_model),
