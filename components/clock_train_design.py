@@ -25,10 +25,13 @@ import math
 from collections.abc import Mapping
 from typing import Any
 
+import numpy as np
+from scipy.optimize import brentq
+
 from .base import Variable, design_parameter
 from .clock_train_kinematics import M739_MESH1, M739_MESH2, M739_TRAIN, ClockMesh, ClockTrain
 from .design_rules import Violation, degrees, inches, plain
-from .m739_data import M739, M739Data
+from .m739_data import M739Data
 from .mesh_efficiency_data import ClockMeshData
 from .sanda2v_deck import BY_NAME, data_from
 from .units import INCH
@@ -228,6 +231,20 @@ def _lengths(i: int, m: ClockMesh) -> str:
     return ", ".join(inches(s[f], getattr(m, f)) for f in ("b", "a_g", "rho_g", "f_p", "rho_p"))
 
 
+def _first_touch(m: ClockMesh, lo: float, hi: float) -> float | None:
+    """The first gear angle in (lo, hi) where the next pair touches (its sensing gap falls
+    through zero), None if it does not there."""
+    grid = np.linspace(lo, hi, 101)
+    try:
+        gaps = [m.sensing_gap(float(x)) for x in grid]
+    except ValueError:
+        return None
+    for k in range(100):
+        if gaps[k] > 0.0 >= gaps[k + 1]:
+            return float(brentq(m.sensing_gap, grid[k], grid[k + 1], xtol=1e-15))
+    return None
+
+
 def mesh_violations(m: ClockMesh, i: int) -> list[Violation]:
     """The broken rules of mesh i, in the order a later rule needs the earlier ones."""
     where = f"mesh {i}"
@@ -255,29 +272,26 @@ def mesh_violations(m: ClockMesh, i: int) -> list[Violation]:
                 f"angle, eqs. 37-40: A^2 + B^2 < C^2) with {_lengths(i, m)}",
             )
         ]
-    try:
-        handover = m.handover()
-        end = m.window_end
-    except (ValueError, StopIteration):
-        return [
-            Violation(
-                "hand-over inside its window",
-                f"{where}: the next pair never touches within 1.5 gear pitches of the "
-                f"transition (sensing equation, eqs. 41-45/83-87) with {_lengths(i, m)}, "
-                f"{plain('N_G', m.n_gear)}, {plain('N_P', m.n_pinion)}",
-            )
-        ]
     t_gear, t_pin = m.transition()
     pitch = 2.0 * math.pi / m.n_gear
-    if not t_gear < handover < t_gear + pitch:
+    touch = _first_touch(m, t_gear - pitch, t_gear + 1.5 * pitch)
+    if touch is None or not t_gear < touch < t_gear + pitch:
+        where_touch = (
+            "never within a gear pitch either side of it"
+            if touch is None
+            else f"at {degrees('phi_G', touch)}"
+        )
         return [
             Violation(
                 "hand-over inside its window",
-                f"{where}: the next pair touches at {degrees('phi_G', handover)}, the flank is "
-                f"reached at {degrees('phi_GT', t_gear)}; expected the hand-over on the flank, "
-                f"within one gear pitch {degrees('2 pi/N_G', pitch)} after it",
+                f"{where}: the flank is reached at {degrees('phi_GT', t_gear)} and the next pair "
+                f"touches {where_touch} (sensing equation, eqs. 41-45/83-87); expected the "
+                f"hand-over on the flank, less than a gear pitch {degrees('2 pi/N_G', pitch)} "
+                f"after it ({_lengths(i, m)}, {plain('N_G', m.n_gear)}, "
+                f"{plain('N_P', m.n_pinion)})",
             )
         ]
+    end = m.window_end
     q = m.pinion_pitch
     for j in range(WINDOW_POINTS + 1):
         x = end + q * j / WINDOW_POINTS
@@ -300,10 +314,11 @@ def mesh_violations(m: ClockMesh, i: int) -> list[Violation]:
         return [
             Violation(
                 "mean ratio N_G/N_P",
-                f"{where}: over one pair window the pinion turns 2 pi/N_P and the gear "
-                f"{travel / q:.6f} times that, against N_P/N_G = {m.n_pinion}/{m.n_gear} = "
-                f"{m.n_pinion / m.n_gear:.6f}; expected equal to {MEAN_RATIO_TOLERANCE:g} "
-                "(the hand-over must bring the next pair one tooth on)",
+                f"{where}: over one pair window the pinion turns 2 pi/N_P = "
+                f"{q:.6f} rad while the gear turns {travel:.6f} rad: mean ratio "
+                f"{q / travel:.6f} against N_G/N_P = {m.n_gear}/{m.n_pinion} = "
+                f"{m.n_gear / m.n_pinion:.6f}; expected equal to {MEAN_RATIO_TOLERANCE:g} "
+                "(the next pair must touch one tooth on, on the four-bar's branch)",
             )
         ]
     return []
