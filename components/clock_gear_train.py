@@ -623,15 +623,21 @@ class ClockGearTrain(TrainComponent):
         train = clock_train(values)
         if self.check_design:
             raise_first(train_violations(train))
-        self._phys = ClockTrainPhysics(
-            train,
-            body_data(values),
-            mu=self.mu,
-            omega=self.spin,
-            loss_model=int(self.loss_model),
-            pivot_loads=self.pivot_loads == 1.0,
-            mesh_phase=self.mesh_phase,
-        )
+        try:
+            self._phys = ClockTrainPhysics(
+                train,
+                body_data(values),
+                mu=self.mu,
+                omega=self.spin,
+                loss_model=int(self.loss_model),
+                pivot_loads=self.pivot_loads == 1.0,
+                mesh_phase=self.mesh_phase,
+            )
+        except (ValueError, StopIteration) as exc:  # check_design = 0 on a broken train
+            raise ComponentError(
+                f"ClockGearTrain: the clock train cannot be assembled at the start ({exc}); "
+                "check_design = 1 names the broken rule"
+            ) from None
         p = self._phys
         self._y = [self.phi_start, self.phi_dot_start, 0.0]
         p.set_mode(self.phi_start, -1 if self.phi_dot_start < 0.0 else 1)
