@@ -2,10 +2,14 @@
 
 The rotor, inertias, eccentricity and spin of the M739 S&A (Lowen & Tepper 1982, ARLCD-TR-82013,
 App. B and Input Data, pp. 7-11; data ``components.m739_data``) drive the escape wheel through
-the two clock meshes of ``components.clock_train_kinematics.M739_TRAIN`` (kinematics of the
-US Army fuze report of about 1980, Task 2, eqs. 1–126) instead of the M739's involute train.
+two clock meshes (kinematics of the US Army fuze report of about 1980, Task 2, eqs. 1–126)
+instead of the M739's involute train.  Every clock-tooth quantity of both meshes, the cluster
+phasing kappa2 and the bodies (the SANDA2V deck's train entries) are design parameters
+(``components.clock_train_design``, refused by its rules at initialization unless
+``check_design = 0``); their defaults are ``components.clock_train_kinematics.M739_TRAIN`` and
+the M739 deck.
 
-Representative geometry (neither source gives a clock tooth form for the M739; the choice is
+Default geometry (neither source gives a clock tooth form for the M739; the choice is
 the one documented in ``components.clock_train_kinematics``): the M739 tooth counts and centre
 distances,
 rotor gear 64 teeth on 0.4701 in to pinion 2 of 9 leaves, gear 2 of 36 teeth on 0.2327 in to
