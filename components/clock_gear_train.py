@@ -2,10 +2,14 @@
 
 The rotor, inertias, eccentricity and spin of the M739 S&A (Lowen & Tepper 1982, ARLCD-TR-82013,
 App. B and Input Data, pp. 7-11; data ``components.m739_data``) drive the escape wheel through
-the two clock meshes of ``components.clock_train_kinematics.M739_TRAIN`` (kinematics of the
-US Army fuze report of about 1980, Task 2, eqs. 1–126) instead of the M739's involute train.
+two clock meshes (kinematics of the US Army fuze report of about 1980, Task 2, eqs. 1–126)
+instead of the M739's involute train.  Every clock-tooth quantity of both meshes, the cluster
+phasing kappa2 and the bodies (the SANDA2V deck's train entries) are design parameters
+(``components.clock_train_design``, refused by its rules at initialization unless
+``check_design = 0``); their defaults are ``components.clock_train_kinematics.M739_TRAIN`` and
+the M739 deck.
 
-Representative geometry (neither source gives a clock tooth form for the M739; the choice is
+Default geometry (neither source gives a clock tooth form for the M739; the choice is
 the one documented in ``components.clock_train_kinematics``): the M739 tooth counts and centre
 distances,
 rotor gear 64 teeth on 0.4701 in to pinion 2 of 9 leaves, gear 2 of 36 teeth on 0.2327 in to
@@ -75,7 +79,10 @@ import math
 from typing import Any
 
 from .base import ComponentError, Variable, common_outputs
+from .clock_train_design import DESIGN_VARIABLES, body_data, clock_train, train_violations
+from .clock_train_design import values_of as design_values
 from .clock_train_kinematics import M739_TRAIN, ClockMesh, ClockTrain
+from .design_rules import raise_first
 from .escape_wheel import (
     ESCAPE_WHEEL_PORT,
     ESCAPE_WHEEL_VARIABLES,
@@ -86,6 +93,7 @@ from .escape_wheel import (
 )
 from .event_integration import INTEGRATION_VARIABLES
 from .m739_data import M739, M739Data
+from .sanda2v_deck import CHECK_DESIGN
 from .train_component import TrainComponent, TrainLoadModel
 
 LOSS_NONE = 0
@@ -140,6 +148,7 @@ class ClockTrainPhysics:
                 f"ClockGearTrain: loss_model {loss_model!r} unknown; expected one of "
                 + ", ".join(f"{k} ({v})" for k, v in LOSS_MODELS.items())
             )
+        self.train = train
         self.meshes: tuple[ClockMesh, ClockMesh] = (train.mesh1, train.mesh2)
         self.kappa2 = train.kappa2
         self.loss_model = int(loss_model)
@@ -530,11 +539,8 @@ class ClockGearTrain(TrainComponent):
     PORTS = {"escape_wheel": ESCAPE_WHEEL_PORT}
 
     VARIABLES = (
-        Variable(
-            "mu", "parameter", "1", M739.mu, "Coulomb friction, mesh contacts and pivots", min=0.0
-        ),
-        # The model takes |omega| (spin in either sense gives the same motion): spin >= 0.
-        Variable("spin", "parameter", "rad/s", M739.omega, "fuze spin rate omega", min=0.0),
+        *DESIGN_VARIABLES,
+        CHECK_DESIGN,
         Variable(
             "loss_model",
             "parameter",
@@ -617,15 +623,25 @@ class ClockGearTrain(TrainComponent):
         self._start_integration()
         if self.pivot_loads not in (0.0, 1.0):
             raise ComponentError("ClockGearTrain: pivot_loads must be 0 or 1")
-        self._phys = ClockTrainPhysics(
-            M739_TRAIN,
-            M739,
-            mu=self.mu,
-            omega=self.spin,
-            loss_model=int(self.loss_model),
-            pivot_loads=self.pivot_loads == 1.0,
-            mesh_phase=self.mesh_phase,
-        )
+        values = design_values(self)
+        train = clock_train(values)
+        if self.check_design:
+            raise_first(train_violations(train))
+        try:
+            self._phys = ClockTrainPhysics(
+                train,
+                body_data(values),
+                mu=self.mu,
+                omega=self.spin,
+                loss_model=int(self.loss_model),
+                pivot_loads=self.pivot_loads == 1.0,
+                mesh_phase=self.mesh_phase,
+            )
+        except (ValueError, StopIteration) as exc:  # check_design = 0 on a broken train
+            raise ComponentError(
+                f"ClockGearTrain: the clock train cannot be assembled at the start ({exc}); "
+                "check_design = 1 names the broken rule"
+            ) from None
         p = self._phys
         self._y = [self.phi_start, self.phi_dot_start, 0.0]
         p.set_mode(self.phi_start, -1 if self.phi_dot_start < 0.0 else 1)

@@ -6,9 +6,11 @@ does for the involute train; a tooth handover is an inelastic impact of the new 
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+
 from components.clock_gear_train import LOSS_POINT, ClockTrainPhysics
-from components.clock_train_kinematics import M739_TRAIN
-from components.m739_data import M739, rpm_to_rad_s
+from components.clock_train_design import body_data, clock_train, design_defaults
+from components.m739_data import M739, M739Data, rpm_to_rad_s
 from components.verge_escapement import (
     IND_MESH_HI,
     IND_MESH_LO,
@@ -55,7 +57,7 @@ def arming_phi(phys: ClockTrainPhysics, rotor_angle: float = ARMING_ROTOR_ANGLE)
     """Cumulative escape-wheel angle at which the rotor reaches rotor_angle (forward kinematics
     of the train, eqs. 1-87 of the clock train report)."""
     theta1 = phys.theta1_0 + (rotor_angle - phys.phi1c)
-    return M739_TRAIN.escape_angle(theta1) - phys.psi0
+    return phys.train.escape_angle(theta1) - phys.psi0
 
 
 def run_clock_train(
@@ -72,22 +74,31 @@ def run_clock_train(
     rotor_arming_angle: float = ARMING_ROTOR_ANGLE,
     tolerance: float = REFERENCE_TOLERANCE,
     sample_dt: float = 1.0e-5,
+    design: Mapping[str, float] | None = None,
+    verge_data: M739Data | None = None,
 ) -> M739Result:
     """Simulate the clock-train S&A from rest on the entrance face until arming or t_stop.
 
-    Same outcome record as ``run_m739`` (turns, force maxima with F12/F23 the mesh normal
-    forces, impacts, regime log, series); it never raises.
+    ``design``: the clock train's design parameters (``components.clock_train_design``; the
+    missing ones at their defaults), as ClockGearTrain takes them; ``verge_data``: the verge's
+    deck (default: the M739's with ``center_distance`` and ``pallet_inertia``).  Same outcome
+    record as ``run_m739`` (turns, force maxima with F12/F23 the mesh normal forces, impacts,
+    regime log, series); it never raises.
     """
     omega = rpm_to_rad_s(rpm)
-    data = escapement_data(center_distance, pallet_inertia=pallet_inertia)
+    if verge_data is None:
+        data = escapement_data(center_distance, pallet_inertia=pallet_inertia)
+    else:
+        data = verge_data
+    values = {**design_defaults(), **(design or {})}
     events: list[tuple[float, int, int, str]] = []
 
     def log(t: float, old: int, new: int, why: str) -> None:
         events.append((t, old, new, why))
 
     train = ClockTrainPhysics(
-        M739_TRAIN,
-        M739,
+        clock_train(values),
+        body_data(values),
         mu=mu,
         omega=omega,
         loss_model=loss_model,

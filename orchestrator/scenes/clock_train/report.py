@@ -30,6 +30,7 @@ from components.verge_escapement import (
 )
 from orchestrator.plotting import recorded
 from orchestrator.scenario import Scene
+from orchestrator.scenes.clock_train.design import train_values, verge_data
 from orchestrator.scenes.clock_train.monolithic import ARMING_ROTOR_ANGLE, run_clock_train
 from orchestrator.scenes.family import Quantity, Reference, quantity
 from orchestrator.scenes.m739.report import (
@@ -99,6 +100,8 @@ def reference(scene: Scene) -> Reference:
         center_distance=_parameter(scene, verge, "center_distance"),
         pallet_inertia=_parameter(scene, verge, "pallet_inertia"),
         rotor_arming_angle=level,
+        design=train_values(scene),
+        verge_data=verge_data(scene),
     )
     ref = reference_from(result, train, verge)
     if result.armed:
