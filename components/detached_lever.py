@@ -78,6 +78,7 @@ from .detached_lever_design import (
     symmetric_deck,
     violations,
 )
+from .event_integration import STEP_BUDGET_VARIABLE, StepBudgetSpent
 
 # Regime codes: FREE, UNLOCK, IMPULSE (the segment kinds), and
 STOPPED = 3
@@ -222,6 +223,7 @@ class DetachedLever(Component):
             "distance (angle or phase) to the next window switch; zero at the switch",
         ),
         Variable("indicator_reversal", "output", "rad/s", 0.0, "balance speed; zero at reversal"),
+        STEP_BUDGET_VARIABLE,
     )
 
     # -- life cycle -------------------------------------------------------------------
@@ -279,7 +281,15 @@ class DetachedLever(Component):
         self._update_outputs(t0)
 
     def step(self, t: float, h: float) -> None:
-        self._advance(t, t + h, stop_at_beat=False)
+        # Every member is a scalar or a tuple: a step that spends its budget is undone
+        # from this copy, so nothing of it is kept.
+        start = dict(self.__dict__)
+        try:
+            self._advance(t, t + h, stop_at_beat=False, budget=int(self.max_internal_steps))
+        except StepBudgetSpent:
+            self.__dict__.clear()
+            self.__dict__.update(start)
+            raise
 
     # -- forces -----------------------------------------------------------------------
     def _forcing_of(self, n: int) -> tuple[float, float]:
@@ -344,11 +354,22 @@ class DetachedLever(Component):
         return False
 
     # -- the integrator ---------------------------------------------------------------
-    def _advance(self, t: float, t_end: float, stop_at_beat: bool) -> float:
-        """Advance to t_end (or to the next extreme); returns the time reached."""
+    def _advance(
+        self, t: float, t_end: float, stop_at_beat: bool, budget: int | None = None
+    ) -> float:
+        """Advance to t_end (or to the next extreme); returns the time reached.  ``budget``:
+        the most pieces of motion (between events) it may take (StepBudgetSpent beyond)."""
         w0sq, half_c, w1, inertia = self._w0sq, self._half_c, self._w1, self.inertia
         phase = self._mode == PHASE_SCHEDULED
+        pieces = 0
         while t < t_end:
+            pieces += 1
+            if budget is not None and pieces > budget:
+                raise StepBudgetSpent(
+                    f"DetachedLever: the step to t = {t_end:.9g} s spent its budget of "
+                    f"{budget} internal steps (max_internal_steps) at t = {t:.9g} s; take "
+                    "shorter communication steps or give a larger budget"
+                )
             if self.regime == STOPPED:
                 if not self._release():
                     t = t_end

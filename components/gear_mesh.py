@@ -62,6 +62,7 @@ import numpy as np
 from .base import COMMON_OUTPUTS, Component, ComponentError, SnapshotPlan, Variable
 from .clock_train_kinematics import M739_MESH1, M739_MESH2, ClockMesh
 from .design_rules import raise_first
+from .event_integration import STEP_BUDGET_VARIABLE, StepBudgetSpent
 from .m739_data import M739
 from .mesh_design import (
     CLOCK_DESIGN,
@@ -505,6 +506,7 @@ class GearMesh(Component):
         Variable("ind_contact", "output", "1", 1.0, "changes sign where a pair enters or leaves"),
         Variable("ind_pitch_point", "output", "1", 1.0, "changes sign where the sliding reverses"),
         *COMMON_OUTPUTS,
+        STEP_BUDGET_VARIABLE,
     )  # fmt: skip
 
     # -- life cycle -------------------------------------------------------------------
@@ -579,7 +581,15 @@ class GearMesh(Component):
         first_event = None
         int_r = int_re = 0.0
         lo = a
+        pieces, budget = 0, int(self.max_internal_steps)
         while lo < b:
+            pieces += 1
+            if pieces > budget:  # nothing of the step is kept yet
+                raise StepBudgetSpent(
+                    f"GearMesh: the step from t = {t:.9g} s over {h:.6g} s spent its budget "
+                    f"of {budget} internal steps (max_internal_steps): smooth pieces between "
+                    "contact changes; take shorter communication steps or give a larger budget"
+                )
             nxt = m.next_break(lo)
             hi = min(nxt, b)
             if nxt <= b and first_event is None:

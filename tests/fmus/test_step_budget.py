@@ -23,6 +23,8 @@ BUDGETED = {
     "ClockGearTrain": {},
     "CrankCouplerDrive": {},
     "VergeEscapement": {"phi_dot": 50.0},
+    "DetachedLever": {},  # event by event: each piece between events counts
+    "GearMesh": {},  # each smooth piece between contact changes counts
 }
 #: closed-form or event-free over any span: the step is taken whole
 WHOLE = ("BrakeLoad", "Inertia", "SpragClutch", "SpringDamperInertia")
