@@ -24,6 +24,11 @@ from typing import Any, ClassVar
 
 #: Keys every master has; the others are its step (STEP_KEYS) and fields of its settings.
 COMMON_KEYS = ("algorithm", "order")
+#: Settings where 0 means "none" rather than being out of range.
+OFF_AT_ZERO = ("call_timeout",)
+#: How long one FMI call may take before the run's supervisor ends it [s] (README, "A
+#: crashing FMU"): an FMU stuck in an endless loop ends its run "timed out".
+CALL_TIMEOUT = 60.0
 
 
 class SettingError(ValueError):
@@ -61,10 +66,11 @@ class FixedStepSettings:
 
     STEP_KEY: ClassVar[str] = "step"
     step: float  # master.step: the macro step [s]
+    call_timeout: float = setting(CALL_TIMEOUT, "s")  # 0: no limit (read by the supervisor)
 
     @classmethod
     def from_options(cls, step: float, duration: float, options: dict[str, Any]):
-        return cls(step)
+        return cls(step, **{k: v for k, v in options.items() if k in _kinds(cls)})
 
 
 @dataclass(frozen=True)
@@ -118,6 +124,7 @@ class RegimeAwareSettings:
     max_iterations: int = setting(10)  # exchange rounds at a switching instant
     max_events_per_step: int = setting(50)  # switches at (nearly) one instant: chattering
     input_hold: str = setting("auto", choices=("auto", "start", "midpoint", "extrapolated"))
+    call_timeout: float = setting(CALL_TIMEOUT, "s")  # 0: no limit (read by the supervisor)
     control: MasterStepControl = MasterStepControl()
     run_duration: float = math.inf  # not a scene key: the run's length (longest_step)
 
@@ -194,8 +201,11 @@ def read_options(node: dict[str, Any], to_si: Callable[[Any, str, str], float]) 
             options[k] = raw
         else:
             value = to_si(raw, f"master.{k}", kind.unit)
-            if not value > 0.0:
-                raise SettingError(k, f"must be positive, got {value}")
+            if k in OFF_AT_ZERO and value == 0.0:
+                pass
+            elif not value > 0.0:
+                off = " (0 for none)" if k in OFF_AT_ZERO else ""
+                raise SettingError(k, f"must be positive{off}, got {value}")
             options[k] = value
     low, high = options.get("min_step"), options.get("max_step")
     if low is not None and high is not None and high < low:
