@@ -2,7 +2,9 @@
 
 Each job is (scene file, overrides, results directory).  Workers load the scene, run it
 and send back numbers only (status, headline, statistics, recorded series), so results
-are the same wherever they ran.  FMUs are built once, before the jobs go out.
+are the same wherever they ran.  FMUs are built once, before the jobs go out.  Local
+workers are supervised (``job_workers``): an FMU that crashes, stops or hangs ends its
+job with status "crashed" or "timed out", and the others go on.
 """
 
 from __future__ import annotations
@@ -20,8 +22,10 @@ from typing import Any
 
 import numpy as np
 
+from orchestrator.errors import ScenarioError
 from orchestrator.run import run_scene
 from orchestrator.scenario import load_scene
+from orchestrator.studies.job_workers import can_supervise_jobs, iter_supervised
 
 
 @dataclass(frozen=True)
@@ -125,15 +129,23 @@ def iter_jobs(
     """Run ``jobs`` in parallel and yield (index, result) as each finishes, an exception in
     place of the result when the job raised (e.g. a sample its scene refuses).  When
     ``stop()`` turns true no further job starts; those under way still report.  The FMUs
-    must be built beforehand (load the scene once).  One worker runs the jobs in this
-    process (a signal then stops the job under way at a step boundary, as ``run`` does)."""
+    must be built beforehand (load the scene once).  Local jobs run in supervised worker
+    processes (``job_workers``), even with one worker."""
+    if workers is not None and workers < 1:
+        raise ScenarioError(
+            "--workers", "", f"expected a positive number of workers, got {workers}"
+        )
     if not jobs:
         return
     stop = stop or (lambda: False)
     if dask_address:
         yield from _iter_dask(jobs, dask_address, stop)
         return
-    workers = workers or min(len(jobs), os.cpu_count() or 1)
+    workers = min(workers or os.cpu_count() or 1, len(jobs))
+    if can_supervise_jobs():
+        yield from iter_supervised(jobs, workers, stop, run_job)
+        return
+    # Without fork (Windows): unsupervised, as a crash there cannot be survived anyway.
     if workers == 1:  # in this process, one after another: no pool to start
         for k, job in enumerate(jobs):
             if stop():
