@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import contextlib
 import ctypes
+import json
 import os
 import signal
 import sys
@@ -171,6 +172,12 @@ def ended_summary(record: flight.Flight, ending: Ending, wall_time: float) -> di
     if run is None:
         return None
     status, message, crash = outcome(record, ending)
+    if record.summary_written:  # it crashed closing its FMUs: the results are whole
+        written = _written_summary(Path(run["output_dir"]))
+        if written is not None:
+            note = f"after the run ended: {message}"
+            written["notes"] = [*written.get("notes", []), note]
+            return {**written, "crash": crash, "output_dir": run["output_dir"]}
     return {
         "scene": run.get("scene"),
         "status": status,
@@ -188,6 +195,14 @@ def ended_summary(record: flight.Flight, ending: Ending, wall_time: float) -> di
         "metadata": {k: run[k] for k in ("scene_file", "fmus") if k in run},
         "output_dir": run["output_dir"],
     }
+
+
+def _written_summary(out: Path) -> dict[str, Any] | None:
+    try:
+        summary = json.loads((out / "summary.json").read_text())
+    except (OSError, ValueError):
+        return None
+    return summary if isinstance(summary, dict) else None
 
 
 def write_ended_summary(summary: dict[str, Any]) -> bool:

@@ -43,6 +43,7 @@ ANNOUNCEMENT_BYTES = 1 << 16
 CALL, FINISHED, CODE, INSTANCES, ANNOUNCED = 0, 2, 3, 4, 5  # int64 words
 TIME = 1  # float64 word: where the last doStep started, or where it ended once it returned
 LIMIT = 6  # float64 word: the longest an FMI call may take [s] (0: no limit)
+WRITTEN = 7  # int64 word: 1 once the run has written its summary (its FMUs still to close)
 _NAMES_AT = 64
 _ANNOUNCEMENT_AT = _NAMES_AT + MAX_INSTANCES * NAME_BYTES
 _SIZE = _ANNOUNCEMENT_AT + ANNOUNCEMENT_BYTES
@@ -95,9 +96,13 @@ class Flight:
 
     def reset(self) -> None:
         """Ready for the next run of the same process (a study's worker)."""
-        for word in (CALL, FINISHED, CODE, INSTANCES, ANNOUNCED):
+        for word in (CALL, FINISHED, CODE, INSTANCES, ANNOUNCED, WRITTEN):
             self.words[word] = 0
         self.reals[TIME] = self.reals[LIMIT] = 0.0
+
+    @property
+    def summary_written(self) -> bool:
+        return bool(self.words[WRITTEN])
 
     @property
     def call_timeout(self) -> float:
@@ -206,9 +211,15 @@ def use(record: Flight) -> None:
     _current = record
 
 
+def summary_written() -> None:
+    """Say that the run's summary is written (only closing its FMUs is left)."""
+    _current.words[WRITTEN] = 1
+
+
 def announce_run(scene: Any, output_dir: Any) -> None:
     """Say which run this process is making (read only if it crashes or hangs)."""
     _current.reals[TIME] = scene.start
+    _current.words[WRITTEN] = 0
     settings = getattr(getattr(scene, "master", None), "settings", None)
     _current.reals[LIMIT] = getattr(settings, "call_timeout", CALL_TIMEOUT)
     _current.announce(

@@ -25,7 +25,7 @@ from orchestrator.accuracy import compare
 from orchestrator.analyses import energy_residual, headline, missing_column
 from orchestrator.errors import RunError
 from orchestrator.execution import execute
-from orchestrator.flight import announce_run
+from orchestrator.flight import announce_run, summary_written
 from orchestrator.fmu_instance import FmuTerminated, file_sha256
 from orchestrator.interrupt import Interrupted, SignalGuard, catching_signals, signal_name
 from orchestrator.masters.regime_aware_choice import fmu_tolerance
@@ -110,8 +110,6 @@ def _run_locked(
     stats = StepStats()
     energy = EnergyBalance(system, recorder.header)
     meta = _metadata(scene, fmu_paths)
-    status, message = "completed", ""
-    notes: list[str] = []
     bar = ProgressBar(
         total=scene.stop - scene.start,
         unit="s(sim)",
@@ -133,6 +131,35 @@ def _run_locked(
 
     start = time.perf_counter()
     try:
+        return _stepped(scene, out, system, recorder, stats, energy, meta, guard, progress,
+                        reached, bar, start, compare_reference, plots)  # fmt: skip
+    finally:
+        # Last: an FMU that crashes as it is terminated or freed (README, "A crashing FMU")
+        # then finds the run's summary written, headline and all.
+        system.close()
+
+
+def _stepped(
+    scene: Scene,
+    out: Path,
+    system: CoupledSystem,
+    recorder: Recorder,
+    stats: StepStats,
+    energy: EnergyBalance,
+    meta: dict[str, Any],
+    guard: SignalGuard,
+    progress: Any,
+    reached: list[float],
+    bar: ProgressBar,
+    start: float,
+    compare_reference: bool,
+    plots: bool,
+) -> RunResult:
+    """Step ``system`` to the end, then analyse, summarize and return the run (the FMUs
+    stay alive: the caller closes them)."""
+    status, message = "completed", ""
+    notes: list[str] = []
+    try:
         guard.check()
         system.initialize(fmu_tolerance(system, scene))
         guard.check()
@@ -153,14 +180,13 @@ def _run_locked(
     finally:
         stats.wall_time = time.perf_counter() - start
         bar.close()
-        system.close()
     recorder.flush()
     data = recorder.array()
     quantities: dict[str, dict[str, Any]] = {}
     accuracy: dict[str, float] = {}
     ref: Reference | None = None
     try:
-        # No FMU is alive any more: a signal may now stop the analyses where it lands.
+        # No FMU is called any more: a signal may now stop the analyses where it lands.
         with guard.raise_at_once(), _without_numeric_warnings():
             quantities, accuracy, ref = _analyse(
                 scene, out, recorder, data, energy, status, compare_reference, plots, notes
@@ -185,6 +211,7 @@ def _run_locked(
             "metadata": meta,
         }
     )
+    summary_written()  # for a supervisor, should closing an FMU crash this process
     return RunResult(
         scene=scene,
         status=status,

@@ -226,6 +226,11 @@ def _report_ending(record: flight.Flight, ending: child_watch.Ending, wall_time:
         return 1
     out = Path(summary["output_dir"])
     written = child_watch.write_ended_summary(summary)
+    if record.summary_written:  # the run had ended: its report, and what happened after
+        from orchestrator.run_text import summary_lines
+
+        print("\n".join(summary_lines(summary, out)))  # its notes say what happened
+        return 1
     print(f"scene {summary['scene']}: {summary['status']} — {summary['message']}")
     print(f"  results in {out}" if written else f"  could not write {out / 'summary.json'}")
     return 128 + signum if signum is not None else 1

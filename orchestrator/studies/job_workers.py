@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import contextlib
 import csv
+import faulthandler
 import multiprocessing.connection as mpc
 import os
 import signal
@@ -151,6 +152,7 @@ def _worker(
         for other in others:
             other.close()
         os.setpgid(0, 0)
+        faulthandler.disable()  # a crash is reported by this process's parent, in one line
         child_watch.die_with_parent(parent)
         _exit_at_once_on_exit()
         flight.use(record)
@@ -206,7 +208,9 @@ def _ended_job(job: Job, worker: _Worker, status: int) -> JobResult:
         child_watch.write_ended_summary(summary)
         ended, message, notes = summary["status"], summary["message"], summary["notes"]
     header, data, events = recorded(Path(job.output_dir))
-    return JobResult(job, ended, message, {}, {"wall_time": wall}, header, data, events, notes)
+    headline = summary.get("headline", {}) if summary else {}  # a run that had ended
+    stats = summary.get("stats", {}) if summary and headline else {"wall_time": wall}
+    return JobResult(job, ended, message, headline, stats, header, data, events, notes)
 
 
 def recorded(out: Path) -> tuple[list[str], np.ndarray, list[tuple[float, str, str, str]]]:
@@ -224,3 +228,31 @@ def recorded(out: Path) -> tuple[list[str], np.ndarray, list[tuple[float, str, s
             if len(row) == 4:
                 events.append((float(row[0]), row[1], row[2], row[3]))
     return header, data, events
+
+
+def call_supervised(fn: Callable[[], Any]) -> Any:
+    """``fn()`` in a supervised worker process: its value, or its exception raised here; a
+    RunError saying how it ended if its process crashed, stopped or hung in an FMI call."""
+    from orchestrator.errors import RunError
+
+    worker = _start_worker([], lambda _job: fn())
+    _hand_out(worker, 0, [None])  # type: ignore[list-item]  # fn takes no job
+    try:
+        while True:
+            if worker.conn.poll(2 * child_watch.POLL):
+                try:
+                    _, outcome = worker.conn.recv()
+                except (EOFError, OSError):
+                    pass  # it died: below
+                else:
+                    worker.job = None
+                    if isinstance(outcome, BaseException):
+                        raise outcome
+                    return outcome
+            status = worker.watch.poll()
+            if status is not None:
+                worker.job = None
+                _, message, _ = child_watch.outcome(worker.record, worker.watch.ending(status))
+                raise RunError(message)
+    finally:
+        _end_workers([worker])

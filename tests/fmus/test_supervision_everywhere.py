@@ -130,6 +130,8 @@ def test_a_sweep_goes_on_past_a_crash_a_hang_and_a_stop(
             assert_ended(out / f"base_{k:03d}", n_sub, unfaulted_rows)
 
 
+@pytest.mark.filterwarnings("ignore:Data has no positive values")  # the study's plots of
+@pytest.mark.filterwarnings("ignore:Tight layout not applied")  # only five samples
 def test_a_study_marks_the_bad_samples_and_completes_the_others(
     fmu: Path,
     healthy: tuple[float, np.ndarray],
@@ -248,3 +250,40 @@ def _alive(pid: int) -> bool:
     except OSError:
         return False
     return state not in ("Z", "X")
+
+
+def test_a_crash_in_fmi2terminate_keeps_the_finished_run(
+    healthy: tuple[float, np.ndarray], tmp_path: Path, capsys: pytest.CaptureFixture
+) -> None:
+    """The run had ended and written its summary: its headline stays, the crash is noted."""
+    fmu = foreign_fmus.build_torsion_body(tmp_path, fault="terminate_segfault")
+    (tmp_path / "t.toml").write_text(scene_text(fmu, "t"))
+    out = tmp_path / "out"
+    assert main(["run", str(tmp_path / "t.toml"), "--no-progress", "--output", str(out)]) == 1
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == "completed"
+    assert summary["headline"]["final_phi"]["value"] == healthy[0]
+    assert summary["crash"]["call"] == "fmi2Terminate" and summary["crash"]["signal"] == 11
+    note = "after the run ended: FMU 'c' crashed in fmi2Terminate at t = 0.02 s: killed by SIGSEGV"
+    assert note in summary["notes"][-1]
+    assert note in capsys.readouterr().out
+
+
+def test_crosscheck_reports_a_crash_in_one_line(fmu: Path, tmp_path: Path, capsys) -> None:
+    (tmp_path / "s.toml").write_text(scene_text(fmu, "s"))
+    args = ["crosscheck", str(tmp_path / "s.toml"), "--tool", "fmpy"]
+    assert main([*args, "--set", f"fmus.c.parameters.n_sub={SEGFAULT}"]) == 2
+    assert capsys.readouterr().err == (
+        "error: our Jacobi run did not complete: FMU 'c' crashed in fmi2DoStep at t = 0.01 s: "
+        "killed by SIGSEGV (signal 11)\n"
+    )
+
+
+def test_a_tool_whose_process_crashes_is_reported() -> None:
+    """ctypes.string_at(0) reads address 0: the spawned process dies of SIGSEGV."""
+    import ctypes
+
+    from orchestrator.studies.crosscheck import ToolCrashed, _in_spawned_process
+
+    with pytest.raises(ToolCrashed, match=r"^fmpy's process ended without an answer: killed by "):
+        _in_spawned_process(ctypes.string_at, 0, "fmpy")
