@@ -27,6 +27,7 @@ from orchestrator.errors import RunError
 from orchestrator.execution import execute
 from orchestrator.flight import announce_run, summary_written
 from orchestrator.fmu_instance import FmuTerminated, file_sha256
+from orchestrator.fmu_log import FmuLog
 from orchestrator.interrupt import Interrupted, SignalGuard, catching_signals, signal_name
 from orchestrator.masters.regime_aware_choice import fmu_tolerance
 from orchestrator.observers import EnergyBalance
@@ -180,6 +181,9 @@ def _stepped(
     finally:
         stats.wall_time = time.perf_counter() - start
         bar.close()
+    warned = fmu_warnings(system)
+    for fmu, log in warned.items():
+        notes.extend(log.notes(fmu))
     recorder.flush()
     data = recorder.array()
     quantities: dict[str, dict[str, Any]] = {}
@@ -209,6 +213,8 @@ def _stepped(
             "notes": notes,
             "stats": stats.as_dict(),
             "metadata": meta,
+            # only where an FMU warned: the summaries of runs without warnings unchanged
+            **({"fmu_warnings": {f: log.summary() for f, log in warned.items()}} if warned else {}),
         }
     )
     summary_written()  # for a supervisor, should closing an FMU crash this process
@@ -298,6 +304,11 @@ def _noted(notes: list[str], what: str, header: list[str]) -> Iterator[None]:
     except Exception as exc:  # noqa: BLE001 - any failure of an analysis is reported, not raised
         text = str(exc).strip().splitlines()[0] if str(exc).strip() else ""
         notes.append(f"{what} not computed: {type(exc).__name__}: {text}".rstrip(": "))
+
+
+def fmu_warnings(system: CoupledSystem) -> dict[str, FmuLog]:
+    """The logs of the FMU instances that warned, by instance name."""
+    return {inst.name: inst.log for inst in system.instances if inst.log.warnings}
 
 
 def fmu_files(scene: Scene, cache_dir: Path | None = None) -> dict[str, Path]:
