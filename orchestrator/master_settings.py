@@ -24,6 +24,9 @@ from typing import Any, ClassVar
 
 #: Keys every master has; the others are its step (STEP_KEYS) and fields of its settings.
 COMMON_KEYS = ("algorithm", "order")
+#: The smallest master.tolerance taken: relative coupling errors of 1e-12 over steps of
+#: 1e-14 s (master.min_step's default) are already near double precision's 2.2e-16.
+MIN_TOLERANCE = 1e-12
 #: Settings where 0 means "none" rather than being out of range.
 OFF_AT_ZERO = ("call_timeout",)
 #: How long one FMI call may take before the run's supervisor ends it [s] (README, "A
@@ -158,7 +161,18 @@ class RegimeAwareSettings:
         """The settings of a scene: ``options`` as read_options gives them, the rest
         defaults."""
         values = {k: v for k, v in options.items() if k in _kinds(cls)}
-        return cls(first_step=step, run_duration=duration, **values)
+        settings = cls(first_step=step, run_duration=duration, **values)
+        if settings.tolerance < MIN_TOLERANCE:
+            raise SettingError(
+                "tolerance",
+                f"must be at least {MIN_TOLERANCE:g} (a smaller one asks for steps below the "
+                f"resolution of the time in double precision), got {settings.tolerance:g}",
+            )
+        if settings.min_step > step:
+            raise SettingError(
+                "min_step", f"{settings.min_step:g} s is longer than the first step ({step:g} s)"
+            )
+        return settings
 
 
 #: Every master's settings, by the name a scene gives its algorithm.
