@@ -168,7 +168,7 @@ class RegimeAwareSettings:
                 f"must be at least {MIN_TOLERANCE:g} (a smaller one asks for steps below the "
                 f"resolution of the time in double precision), got {settings.tolerance:g}",
             )
-        if settings.min_step > step:
+        if "min_step" in options and settings.min_step > step:
             raise SettingError(
                 "min_step", f"{settings.min_step:g} s is longer than the first step ({step:g} s)"
             )

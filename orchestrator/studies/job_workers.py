@@ -26,14 +26,12 @@ from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from multiprocessing import Pipe
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
 from orchestrator import child_watch, flight, interrupt
-
-if TYPE_CHECKING:
-    from orchestrator.studies.jobs import Job, JobResult
+from orchestrator.studies.job_types import Job, JobResult
 
 
 def can_supervise_jobs() -> bool:
@@ -195,8 +193,6 @@ def _end_workers(pool: list[_Worker]) -> None:
 def _ended_job(job: Job, worker: _Worker, status: int) -> JobResult:
     """The result of a job whose worker died, stopped or hung: what its flight record
     says, its summary written, the series it recorded read back."""
-    from orchestrator.studies.jobs import JobResult
-
     wall = time.perf_counter() - worker.started
     ending = worker.watch.ending(status)
     summary = child_watch.ended_summary(worker.record, ending, wall)

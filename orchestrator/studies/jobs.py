@@ -16,41 +16,14 @@ import sys
 import threading
 from collections.abc import Callable, Iterator
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
-
-import numpy as np
 
 from orchestrator.errors import ScenarioError
 from orchestrator.run import run_scene
 from orchestrator.scenario import load_scene
+from orchestrator.studies.job_types import Job, JobResult
 from orchestrator.studies.job_workers import can_supervise_jobs, iter_supervised
-
-
-@dataclass(frozen=True)
-class Job:
-    scene: str  # path of the scenario file
-    overrides: dict[str, Any]
-    output_dir: str
-    label: str = ""
-    #: compare with the scene's reference inside the run; a study that shares one
-    #: reference among its jobs computes it once itself and says False
-    compare_reference: bool = True
-    plots: bool = True  # draw the scene analysis's plot
-
-
-@dataclass
-class JobResult:
-    job: Job
-    status: str
-    message: str
-    headline: dict[str, dict[str, Any]]
-    stats: dict[str, Any]
-    header: list[str]
-    data: np.ndarray
-    events: list[tuple[float, str, str, str]]
-    notes: list[str] = field(default_factory=list)  # what the analyses could not compute
 
 
 def run_job(job: Job) -> JobResult:
