@@ -9,17 +9,21 @@ the run), and the supervisor reads it when the run's process has died.  That is 
 into a memoryview per call (four for doStep), against 1-30 µs for the FMI call itself
 (README, "A crashing FMU").
 
-The run also announces itself here (scene, results directory), so that the supervisor
-knows where to write the summary of a run that crashed.
+The run also announces itself here (scene, results directory, the longest an FMI call may
+take), so that the supervisor knows where to write the summary of a run that crashed, and
+when a call that does not return is to be ended (``CallWatch``).
 """
 
 from __future__ import annotations
 
 import json
 import mmap
+from dataclasses import dataclass
 from typing import Any
 
 from fmpy.fmi2 import FMU2Slave
+
+from orchestrator.master_settings import CALL_TIMEOUT
 
 #: FMI functions by number; 0 is "none under way", 1 the loading of the shared library.
 CALLS: tuple[str, ...] = (
@@ -38,6 +42,8 @@ ANNOUNCEMENT_BYTES = 1 << 16
 # index): one store before a call, one after it (the slot alone: no call under way).
 CALL, FINISHED, CODE, INSTANCES, ANNOUNCED = 0, 2, 3, 4, 5  # int64 words
 TIME = 1  # float64 word: where the last doStep started, or where it ended once it returned
+LIMIT = 6  # float64 word: the longest an FMI call may take [s] (0: no limit)
+WRITTEN = 7  # int64 word: 1 once the run has written its summary (its FMUs still to close)
 _NAMES_AT = 64
 _ANNOUNCEMENT_AT = _NAMES_AT + MAX_INSTANCES * NAME_BYTES
 _SIZE = _ANNOUNCEMENT_AT + ANNOUNCEMENT_BYTES
@@ -88,6 +94,20 @@ class Flight:
         except ValueError:
             return None
 
+    def reset(self) -> None:
+        """Ready for the next run of the same process (a study's worker)."""
+        for word in (CALL, FINISHED, CODE, INSTANCES, ANNOUNCED, WRITTEN):
+            self.words[word] = 0
+        self.reals[TIME] = self.reals[LIMIT] = 0.0
+
+    @property
+    def summary_written(self) -> bool:
+        return bool(self.words[WRITTEN])
+
+    @property
+    def call_timeout(self) -> float:
+        return self.reals[LIMIT]
+
     def finish(self, code: int) -> None:
         self.words[CODE] = code
         self.words[FINISHED] = 1
@@ -119,6 +139,51 @@ class Flight:
         return self.instance_name(self.words[CALL] >> 16)
 
 
+@dataclass(frozen=True)
+class StuckCall:
+    """An FMI call under way for longer than the run's limit."""
+
+    fmu: str
+    call: str
+    time: float  # where the FMU was: the start of its doStep, or the end of the last one
+    limit: float  # [s]
+
+    def describe(self) -> str:
+        return (
+            f"FMU {self.fmu!r} did not return from {self.call} within {self.limit:g} s "
+            f"(master.call_timeout) at t = {self.time:.9g} s"
+        )
+
+
+class CallWatch:
+    """Watches a record from another process: a call is stuck when the record has shown it
+    under way, unchanged (same instance, function and time), at every look for longer than
+    the limit.  Looking every 0.1 s, calls of one function that return and start again
+    unseen for a whole minute are as good as one call that never returns."""
+
+    def __init__(self, record: Flight) -> None:
+        self.record = record
+        self.seen: tuple[int, float] | None = None
+        self.since = 0.0
+
+    def stuck(self, now: float) -> StuckCall | None:
+        """The call under way if it has been for longer than the limit (``now``: a
+        monotonic clock [s])."""
+        word, t, limit = self.record.words[CALL], self.record.time, self.record.call_timeout
+        if word & 0xFFFF == 0:  # no call under way
+            self.seen = None
+            return None
+        if (word, t) != self.seen:
+            self.seen, self.since = (word, t), now
+            return None
+        if limit <= 0.0 or now - self.since <= limit:
+            return None
+        under_way = self.record.call_under_way()
+        if under_way is None:
+            return None
+        return StuckCall(under_way[0], under_way[1], t, limit)
+
+
 _current = Flight(bytearray(_SIZE))  # private until shared
 
 
@@ -130,14 +195,33 @@ def current() -> Flight:
 def share() -> Flight:
     """A fresh record in anonymous shared memory: a process forked after this call writes
     where this one reads."""
-    global _current
-    _current = Flight(mmap.mmap(-1, _SIZE))
+    use(shared())
     return _current
 
 
+def shared() -> Flight:
+    """A fresh record in anonymous shared memory, for a process about to be forked (which
+    takes it with ``use``)."""
+    return Flight(mmap.mmap(-1, _SIZE))
+
+
+def use(record: Flight) -> None:
+    """Make ``record`` this process's record."""
+    global _current
+    _current = record
+
+
+def summary_written() -> None:
+    """Say that the run's summary is written (only closing its FMUs is left)."""
+    _current.words[WRITTEN] = 1
+
+
 def announce_run(scene: Any, output_dir: Any) -> None:
-    """Say which run this process is making (read only if it crashes)."""
+    """Say which run this process is making (read only if it crashes or hangs)."""
     _current.reals[TIME] = scene.start
+    _current.words[WRITTEN] = 0
+    settings = getattr(getattr(scene, "master", None), "settings", None)
+    _current.reals[LIMIT] = getattr(settings, "call_timeout", CALL_TIMEOUT)
     _current.announce(
         {
             "scene": scene.name,

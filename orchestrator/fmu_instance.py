@@ -1,8 +1,9 @@
 """One instantiated co-simulation FMU, driven through fmpy.
 
 Names are resolved to value references once; the hot-path calls (set inputs, do_step,
-get outputs, get/set state) take prepared reference lists.  Messages the FMU logs are
-kept, so a failed step can say what the FMU said.
+get outputs, get/set state) take prepared reference lists.  The last messages the FMU
+logs are kept, so a failed step can say what the FMU said, and its warnings are counted
+(``orchestrator.fmu_log``).
 """
 
 from __future__ import annotations
@@ -38,6 +39,7 @@ from fmpy.fmi2 import (  # the allocators fmpy itself hands to FMUs, and its val
 
 from orchestrator import flight
 from orchestrator.errors import RunError
+from orchestrator.fmu_log import FmuLog
 
 _UNPACKED: dict[str, tuple[Any, str]] = {}
 
@@ -68,14 +70,15 @@ class FmiCallError(RunError):
 # it, which ctypes cannot receive; fmpy's native proxy (fmpy.logging) formats them and
 # hands the text on.  The proxy keeps one logger for the process, so there is one here,
 # which passes each message to its instance by the componentEnvironment it was given.
-_LOGS: dict[int, Callable[[str], None]] = {}
+_LOGS: dict[int, Callable[[int, str, str], None]] = {}
 _ENVIRONMENTS = itertools.count(1)
 
 
 def _log_message(env: Any, instance: bytes, status: int, category: bytes, message: bytes) -> None:
     keep = _LOGS.get(env or 0)
     if keep is not None:
-        keep(message.decode("utf-8", "replace") if message else "")
+        text = message.decode("utf-8", "replace") if message else ""
+        keep(status, category.decode("utf-8", "replace") if category else "", text)
     else:  # an FMU instantiated with fmpy's default callbacks, in the same process
         printLogMessage(env, instance, status, category, message)
 
@@ -125,9 +128,9 @@ class FmuInstance:
         md, unzip_dir = _unpacked(str(self.path))
         self.model_description = md
         self.variables = {v.name: v for v in md.modelVariables}
-        self.messages: list[str] = []
+        self.log = FmuLog()
         self._env = next(_ENVIRONMENTS)
-        _LOGS[self._env] = self.messages.append
+        _LOGS[self._env] = self._logged
         self._callbacks = fmi2CallbackFunctions()
         self._callbacks.logger = _LOGGER
         self._callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
@@ -168,9 +171,12 @@ class FmuInstance:
         self._set_state = self._function("fmi2SetFMUstate")
         self._free_state = self._function("fmi2FreeFMUstate")
 
+    def _logged(self, status: int, category: str, message: str) -> None:
+        self.log.add(status, category, message, self._flight.time)
+
     def last_lines(self, n: int = LAST_LINES) -> str:
         """The FMU's last ``n`` log messages, oldest first."""
-        return "; ".join(m.strip() for m in self.messages[-n:] if m.strip())
+        return self.log.last(n)
 
     def _failed(self, function: str, status: int, logged: int | None = None) -> FmiCallError:
         """The error of an FMI call that returned ``status``: what the FMU logged during
@@ -204,7 +210,7 @@ class FmuInstance:
     ) -> None:
         """Set parameters and input start values, then leave initialization mode; a
         ``tolerance`` is the FMU's own integration tolerance (fmi2SetupExperiment)."""
-        logged = len(self.messages)
+        logged = self.log.count
         try:
             self.fmu.setupExperiment(tolerance=tolerance, startTime=start, stopTime=stop)
             self.fmu.enterInitializationMode()
@@ -224,7 +230,7 @@ class FmuInstance:
             raise RunError(f"initialization failed: {said}", start, self.name) from None
 
     def do_step(self, t: float, h: float) -> None:
-        logged = len(self.messages)
+        logged = self.log.count
         try:
             self._do_step(self.fmu.component, t, h, fmi2True)
         except FmiCallError as exc:
@@ -247,8 +253,9 @@ class FmuInstance:
             return False
 
     def said_since(self, index: int) -> str:
-        """What the FMU logged since ``index`` (its reason first, the runtime's after)."""
-        return "; ".join(m.strip() for m in self.messages[index:] if m.strip())
+        """What the FMU logged since line ``index`` (its reason first, the runtime's after),
+        its last lines only."""
+        return self.log.said_since(index)
 
     # -- values -----------------------------------------------------------------------
     def get_real(self, refs: list[int]) -> list[float]:
@@ -271,7 +278,10 @@ class FmuInstance:
         def noted(name: str, *args: Any) -> Any:
             words[at] = flight.call_word(slot, name)
             try:
-                return call(name, *args)
+                status = call(name, *args)
+                if status == 1:  # fmi2Warning
+                    self.log.returned_warning(name, self._flight.time)
+                return status
             except FMICallException as exc:
                 raise self._failed(name, exc.status) from None
             finally:
@@ -291,8 +301,10 @@ class FmuInstance:
                 reals[at_time] = t
                 status = raw(component, t, h, last)
                 words[at] = idle
-                if status > 1:
-                    raise self._failed(name, status)
+                if status:
+                    if status > 1:
+                        raise self._failed(name, status)
+                    self.log.returned_warning(name, t)
                 reals[at_time] = t + h
                 return status
 
@@ -302,8 +314,10 @@ class FmuInstance:
             words[at] = busy
             status = raw(*args)
             words[at] = idle
-            if status > 1:  # fmi2Discard, fmi2Error, fmi2Fatal (as fmpy raises them)
-                raise self._failed(name, status)
+            if status:
+                if status > 1:  # fmi2Discard, fmi2Error, fmi2Fatal (as fmpy raises them)
+                    raise self._failed(name, status)
+                self.log.returned_warning(name, self._flight.time)
             return status
 
         return call

@@ -24,6 +24,14 @@ from typing import Any, ClassVar
 
 #: Keys every master has; the others are its step (STEP_KEYS) and fields of its settings.
 COMMON_KEYS = ("algorithm", "order")
+#: The smallest master.tolerance taken: relative coupling errors of 1e-12 over steps of
+#: 1e-14 s (master.min_step's default) are already near double precision's 2.2e-16.
+MIN_TOLERANCE = 1e-12
+#: Settings where 0 means "none" rather than being out of range.
+OFF_AT_ZERO = ("call_timeout",)
+#: How long one FMI call may take before the run's supervisor ends it [s] (README, "A
+#: crashing FMU"): an FMU stuck in an endless loop ends its run "timed out".
+CALL_TIMEOUT = 60.0
 
 
 class SettingError(ValueError):
@@ -61,10 +69,11 @@ class FixedStepSettings:
 
     STEP_KEY: ClassVar[str] = "step"
     step: float  # master.step: the macro step [s]
+    call_timeout: float = setting(CALL_TIMEOUT, "s")  # 0: no limit (read by the supervisor)
 
     @classmethod
     def from_options(cls, step: float, duration: float, options: dict[str, Any]):
-        return cls(step)
+        return cls(step, **{k: v for k, v in options.items() if k in _kinds(cls)})
 
 
 @dataclass(frozen=True)
@@ -141,6 +150,7 @@ class RegimeAwareSettings:
     max_iterations: int = setting(10)  # exchange rounds at a switching instant
     max_events_per_step: int = setting(50)  # switches at (nearly) one instant: chattering
     input_hold: str = setting("auto", choices=("auto", "start", "midpoint", "extrapolated"))
+    call_timeout: float = setting(CALL_TIMEOUT, "s")  # 0: no limit (read by the supervisor)
     control: MasterStepControl = MasterStepControl()
     single_pass_control: SinglePassControl = SinglePassControl()
     run_duration: float = math.inf  # not a scene key: the run's length (longest_step)
@@ -174,7 +184,18 @@ class RegimeAwareSettings:
         """The settings of a scene: ``options`` as read_options gives them, the rest
         defaults."""
         values = {k: v for k, v in options.items() if k in _kinds(cls)}
-        return cls(first_step=step, run_duration=duration, **values)
+        settings = cls(first_step=step, run_duration=duration, **values)
+        if settings.tolerance < MIN_TOLERANCE:
+            raise SettingError(
+                "tolerance",
+                f"must be at least {MIN_TOLERANCE:g} (a smaller one asks for steps below the "
+                f"resolution of the time in double precision), got {settings.tolerance:g}",
+            )
+        if "min_step" in options and settings.min_step > step:
+            raise SettingError(
+                "min_step", f"{settings.min_step:g} s is longer than the first step ({step:g} s)"
+            )
+        return settings
 
 
 #: Every master's settings, by the name a scene gives its algorithm.
@@ -217,8 +238,11 @@ def read_options(node: dict[str, Any], to_si: Callable[[Any, str, str], float]) 
             options[k] = raw
         else:
             value = to_si(raw, f"master.{k}", kind.unit)
-            if not value > 0.0:
-                raise SettingError(k, f"must be positive, got {value}")
+            if k in OFF_AT_ZERO and value == 0.0:
+                pass
+            elif not value > 0.0:
+                off = " (0 for none)" if k in OFF_AT_ZERO else ""
+                raise SettingError(k, f"must be positive{off}, got {value}")
             options[k] = value
     low, high = options.get("min_step"), options.get("max_step")
     if low is not None and high is not None and high < low:

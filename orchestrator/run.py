@@ -25,8 +25,9 @@ from orchestrator.accuracy import compare
 from orchestrator.analyses import energy_residual, headline, missing_column
 from orchestrator.errors import RunError
 from orchestrator.execution import execute
-from orchestrator.flight import announce_run
+from orchestrator.flight import announce_run, summary_written
 from orchestrator.fmu_instance import FmuTerminated, file_sha256
+from orchestrator.fmu_log import FmuLog
 from orchestrator.interrupt import Interrupted, SignalGuard, catching_signals, signal_name
 from orchestrator.masters.regime_aware_choice import fmu_tolerance
 from orchestrator.observers import EnergyBalance
@@ -110,8 +111,6 @@ def _run_locked(
     stats = StepStats()
     energy = EnergyBalance(system, recorder.header)
     meta = _metadata(scene, fmu_paths)
-    status, message = "completed", ""
-    notes: list[str] = []
     bar = ProgressBar(
         total=scene.stop - scene.start,
         unit="s(sim)",
@@ -133,6 +132,35 @@ def _run_locked(
 
     start = time.perf_counter()
     try:
+        return _stepped(scene, out, system, recorder, stats, energy, meta, guard, progress,
+                        reached, bar, start, compare_reference, plots)  # fmt: skip
+    finally:
+        # Last: an FMU that crashes as it is terminated or freed (README, "A crashing FMU")
+        # then finds the run's summary written, headline and all.
+        system.close()
+
+
+def _stepped(
+    scene: Scene,
+    out: Path,
+    system: CoupledSystem,
+    recorder: Recorder,
+    stats: StepStats,
+    energy: EnergyBalance,
+    meta: dict[str, Any],
+    guard: SignalGuard,
+    progress: Any,
+    reached: list[float],
+    bar: ProgressBar,
+    start: float,
+    compare_reference: bool,
+    plots: bool,
+) -> RunResult:
+    """Step ``system`` to the end, then analyse, summarize and return the run (the FMUs
+    stay alive: the caller closes them)."""
+    status, message = "completed", ""
+    notes: list[str] = []
+    try:
         guard.check()
         system.initialize(fmu_tolerance(system, scene))
         guard.check()
@@ -153,14 +181,16 @@ def _run_locked(
     finally:
         stats.wall_time = time.perf_counter() - start
         bar.close()
-        system.close()
+    warned = fmu_warnings(system)
+    for fmu, log in warned.items():
+        notes.extend(log.notes(fmu))
     recorder.flush()
     data = recorder.array()
     quantities: dict[str, dict[str, Any]] = {}
     accuracy: dict[str, float] = {}
     ref: Reference | None = None
     try:
-        # No FMU is alive any more: a signal may now stop the analyses where it lands.
+        # No FMU is called any more: a signal may now stop the analyses where it lands.
         with guard.raise_at_once(), _without_numeric_warnings():
             quantities, accuracy, ref = _analyse(
                 scene, out, recorder, data, energy, status, compare_reference, plots, notes
@@ -183,8 +213,11 @@ def _run_locked(
             "notes": notes,
             "stats": stats.as_dict(),
             "metadata": meta,
+            # only where an FMU warned: the summaries of runs without warnings unchanged
+            **({"fmu_warnings": {f: log.summary() for f, log in warned.items()}} if warned else {}),
         }
     )
+    summary_written()  # for a supervisor, should closing an FMU crash this process
     return RunResult(
         scene=scene,
         status=status,
@@ -271,6 +304,11 @@ def _noted(notes: list[str], what: str, header: list[str]) -> Iterator[None]:
     except Exception as exc:  # noqa: BLE001 - any failure of an analysis is reported, not raised
         text = str(exc).strip().splitlines()[0] if str(exc).strip() else ""
         notes.append(f"{what} not computed: {type(exc).__name__}: {text}".rstrip(": "))
+
+
+def fmu_warnings(system: CoupledSystem) -> dict[str, FmuLog]:
+    """The logs of the FMU instances that warned, by instance name."""
+    return {inst.name: inst.log for inst in system.instances if inst.log.warnings}
 
 
 def fmu_files(scene: Scene, cache_dir: Path | None = None) -> dict[str, Path]:

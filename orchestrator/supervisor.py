@@ -9,7 +9,10 @@ the flight record the child kept in shared memory (``orchestrator.flight``).  Th
 files are written a row at a time (``Recorder``), so they hold every completed step.
 
 The child gets its own process group: a Ctrl-C at the terminal then reaches the parent
-only, which forwards it, so the run sees each signal once, as it did unsupervised.
+only, which forwards it, so the run sees each signal once, as it did unsupervised.  A child
+that stops, hangs in an FMI call longer than the scene's ``master.call_timeout``, or does
+not end within ``child_watch.SIGNAL_GRACE`` of a forwarded signal is killed, and the run
+summarized as "crashed", "timed out" or "interrupted" (``orchestrator.child_watch``).
 """
 
 from __future__ import annotations
@@ -29,11 +32,10 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any, TextIO
 
-from orchestrator import flight
+from orchestrator import child_watch, flight
 from orchestrator.interrupt import SIGNALS, SignalGuard, signal_name
-from orchestrator.summary_file import write_summary
 
-CRASHED = "crashed"
+CRASHED = child_watch.CRASHED
 
 
 def can_supervise() -> bool:
@@ -53,21 +55,21 @@ def supervised(work: Callable[[], int], guard: SignalGuard) -> int:
     signals_before = guard.count
     started = time.perf_counter()
     parent = os.getpid()
+    child_watch.prepare_children()
     pid = os.fork()
     if pid == 0:  # the run
         _child(work, record, relays, parent)
     for relay in relays:
         relay.parent()
-    forwarder = _Forwarder(pid, guard)
+    watch = child_watch.ChildWatch(pid, record)
+    forwarder = _Forwarder(watch, guard)
     with forwarder.installed(signals_before):
-        status = _wait(pid)
+        status = watch.wait()
     for relay in relays:
         relay.join()
     if record.finished:
         return record.code
-    if forwarder.killed is not None:  # the third signal: ended at once, as unsupervised
-        return 128 + forwarder.killed
-    return _report_crash(record, status, time.perf_counter() - started)
+    return _report_ending(record, watch.ending(status), time.perf_counter() - started)
 
 
 def _child(
@@ -103,15 +105,9 @@ def _child(
 
 
 def _end_with_parent(parent: int) -> None:
-    """Linux: a SIGTERM when the parent dies (the run then stops at a step boundary and
-    keeps its data), rather than running on as an orphan."""
-    if not sys.platform.startswith("linux"):
-        return
-    with contextlib.suppress(Exception):
-        libc = ctypes.CDLL(None, use_errno=True)
-        libc.prctl(1, signal.SIGTERM, 0, 0, 0)  # PR_SET_PDEATHSIG
-        if os.getppid() != parent:  # it died before the call
-            os.kill(os.getpid(), signal.SIGTERM)
+    """SIGTERM when the parent dies (the run then stops at a step boundary and keeps its
+    data), and the end soon after should an FMI call never return: no orphan."""
+    child_watch.die_with_parent(parent)
 
 
 _ON_EXIT: list[Any] = []  # the handler, kept alive
@@ -133,34 +129,22 @@ def _exit_at_once_on_exit() -> None:
             _ON_EXIT.append(handler)
 
 
-def _wait(pid: int) -> int:
-    while True:
-        try:
-            _, status = os.waitpid(pid, 0)  # retried after a signal's handler (PEP 475)
-            return status
-        except ChildProcessError:
-            return 0
-
-
 class _Forwarder:
-    """While the child runs: SIGINT/SIGTERM go to it.  The third ends it at once (SIGKILL),
-    as the run's own guard would end an unsupervised run (an FMU call that never returns
-    cannot run the child's handler)."""
+    """While the child runs: SIGINT/SIGTERM go to it (killed if it has not ended
+    SIGNAL_GRACE later).  The third kills it at once, as the run's own guard would end an
+    unsupervised run (an FMU call that never returns cannot run the child's handler)."""
 
-    def __init__(self, pid: int, guard: SignalGuard) -> None:
-        self.pid, self.guard = pid, guard
-        self.killed: int | None = None
+    def __init__(self, watch: child_watch.ChildWatch, guard: SignalGuard) -> None:
+        self.watch, self.guard = watch, guard
 
     def handle(self, signum: int, frame: object) -> None:
         if self.guard.signum is None:
             self.guard.signum = signum
         self.guard.count += 1
-        with contextlib.suppress(ProcessLookupError):
-            if self.guard.count >= 3:
-                self.killed = self.guard.signum
-                os.kill(self.pid, signal.SIGKILL)
-            else:
-                os.kill(self.pid, signum)
+        if self.guard.count >= 3:
+            self.watch.kill(interrupted_by=self.guard.signum, at_once=True)
+        else:
+            self.watch.ask_to_stop(signum)
 
     @contextlib.contextmanager
     def installed(self, signals_before: int):  # noqa: ANN201 - a context manager
@@ -173,8 +157,7 @@ class _Forwarder:
             signal.signal(sig, self.handle)
         # A signal between the fork and here reached only this process: pass it on.
         for _ in range(self.guard.count - signals_before):
-            with contextlib.suppress(ProcessLookupError):
-                os.kill(self.pid, self.guard.signum or signal.SIGTERM)
+            self.watch.ask_to_stop(self.guard.signum or signal.SIGTERM)
         try:
             yield
         finally:
@@ -230,72 +213,29 @@ class _Relay:
             self.thread.join()
 
 
-def crash_cause(status: int) -> str:
-    """What ended a process, from its wait status."""
-    if os.WIFSIGNALED(status):
-        sig = os.WTERMSIG(status)
-        return f"killed by {signal_name(sig)} (signal {sig})"
-    if os.WIFEXITED(status):
-        return f"exit code {os.WEXITSTATUS(status)} (an exit() before the run had ended)"
-    return f"wait status {status}"
+crash_cause = child_watch.crash_cause  # where it was first defined
 
 
-def _report_crash(record: flight.Flight, status: int, wall_time: float) -> int:
-    cause = crash_cause(status)
-    under_way = record.call_under_way()
-    t = record.time
-    run = record.announcement()
-    if under_way is not None:
-        fmu, call = under_way
-        where = f"FMU {fmu!r} crashed in {call}"
-    elif record.last_instance() is not None:
-        fmu, call = record.last_instance(), None
-        where = f"the run crashed outside any FMI call (last FMU called: {fmu!r})"
-    else:
-        fmu, call = None, None
-        where = "the run crashed before any FMU was loaded"
-    time_reached = t
-    if run is None:  # before the run began (loading the scene, building its FMUs)
+def _report_ending(record: flight.Flight, ending: child_watch.Ending, wall_time: float) -> int:
+    """Summarize and report a run whose process ended before finishing; the exit code."""
+    summary = child_watch.ended_summary(record, ending, wall_time)
+    signum = ending.interrupted_by
+    if summary is None:  # before the run began (loading the scene, building its FMUs)
+        if signum is not None:
+            print(f"interrupted by {signal_name(signum)}", file=sys.stderr)
+            return 128 + signum
+        cause = child_watch.crash_cause(ending.status)
+        if ending.stopped_by is not None:
+            cause = child_watch.outcome(record, ending)[2]["cause"]
         print(f"error: the command crashed before its run began: {cause}", file=sys.stderr)
         return 1
-    message = f"{where} at t = {time_reached:.9g} s: {cause}"
-    out = Path(run["output_dir"])
-    summary = {
-        "scene": run.get("scene"),
-        "status": CRASHED,
-        "message": message,
-        "time_reached": time_reached,
-        "crash": {
-            "cause": cause,
-            "signal": os.WTERMSIG(status) if os.WIFSIGNALED(status) else None,
-            "exit_code": os.WEXITSTATUS(status) if os.WIFEXITED(status) else None,
-            "fmu": fmu,
-            "call": call,
-        },
-        "headline": {},
-        "accuracy": {},
-        "notes": [
-            "the run's process crashed: the series hold every step completed before it; "
-            "no headline quantities, analyses or reference comparison"
-        ],
-        "stats": {"wall_time": wall_time},
-        "metadata": {k: run[k] for k in ("scene_file", "fmus") if k in run},
-    }
-    written = _write_summary(out, summary)
-    print(f"scene {run.get('scene')}: {CRASHED} — {message}")
+    out = Path(summary["output_dir"])
+    written = child_watch.write_ended_summary(summary)
+    if record.summary_written:  # the run had ended: its report, and what happened after
+        from orchestrator.run_text import summary_lines
+
+        print("\n".join(summary_lines(summary, out)))  # its notes say what happened
+        return 1
+    print(f"scene {summary['scene']}: {summary['status']} — {summary['message']}")
     print(f"  results in {out}" if written else f"  could not write {out / 'summary.json'}")
-    return 1
-
-
-def _write_summary(out: Path, summary: dict[str, Any]) -> bool:
-    """``summary.json`` written whole (temporary file, then renamed), under the lock of the
-    results directory the dead run held."""
-    from orchestrator.output_lock import OutputLock
-
-    try:
-        with OutputLock(out):
-            write_summary(out, summary)
-    except Exception as exc:  # noqa: BLE001 - the crash is reported even so
-        print(f"error: cannot write {out / 'summary.json'}: {exc}", file=sys.stderr)
-        return False
-    return True
+    return 128 + signum if signum is not None else 1

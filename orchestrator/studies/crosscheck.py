@@ -36,12 +36,14 @@ from typing import Any
 import numpy as np
 
 from orchestrator.errors import RunError, ScenarioError
+from orchestrator.interrupt import signal_name
 from orchestrator.osp_export import export_osp
 from orchestrator.run import RunResult, fmu_files, run_scene
 from orchestrator.scenario import Scene, load_scene
 from orchestrator.signals import libcosim_scenario, scene_signals
 from orchestrator.ssp_export import export_ssp
 from orchestrator.ssp_import import load_ssp
+from orchestrator.studies.job_workers import call_supervised
 from orchestrator.studies.tool_runs import fmpy_run, fmpy_simulate_run, libcosim_run
 
 TOOLS = ("libcosim", "fmpy")
@@ -214,14 +216,76 @@ def run_tool(
         **(_simulate_job(scene, cache_dir) if child is fmpy_simulate_run else {}),
     }
     started = time.perf_counter()
-    with mp.get_context("spawn").Pool(1) as pool:
-        header, rows = pool.apply(child, (job,))
+    header, rows = _in_spawned_process(child, job, tool)
     wall = time.perf_counter() - started
     data = np.array(rows, dtype=float).reshape(len(rows), len(header))
     return ToolRun(tool, what, header, data, wall, not_compared)
 
 
-def agreement(ours: RunResult, theirs: ToolRun, scene: Scene) -> Agreement:
+def _in_spawned_process(child: Any, job: dict[str, Any], tool: str) -> Any:
+    """``child(job)`` in a fresh process (the tool's libraries loaded there only); its
+    exception raised here; ToolCrashed if that process dies without an answer."""
+    context = mp.get_context("spawn")
+    mine, theirs = context.Pipe(duplex=False)
+    process = context.Process(target=_answer, args=(child, job, theirs), daemon=True)
+    process.start()
+    theirs.close()
+    try:
+        while not mine.poll(0.1) and process.is_alive():
+            pass
+        try:
+            ok, value = mine.recv()
+        except EOFError:  # it died without an answer
+            process.join()
+            code = process.exitcode or 0
+            cause = (
+                f"killed by {signal_name(-code)} (signal {-code})"
+                if code < 0
+                else f"exit code {code}"
+            )
+            raise ToolCrashed(f"{tool}'s process ended without an answer: {cause}") from None
+    finally:
+        mine.close()
+        if process.is_alive():
+            process.kill()
+        process.join()
+    if not ok:
+        raise value
+    return value
+
+
+def _answer(child: Any, job: dict[str, Any], conn: Any) -> None:
+    try:
+        conn.send((True, child(job)))
+    except Exception as exc:  # noqa: BLE001 - raised again in the parent
+        conn.send((False, exc))
+
+
+class ToolCrashed(RunError):
+    """The tool's process died (a crash in an FMU or in the tool) before it answered."""
+
+
+@dataclass
+class _Series:
+    """Our run's recorded series (what ``agreement`` reads of it)."""
+
+    header: list[str]
+    data: np.ndarray
+
+    def signal(self, name: str) -> np.ndarray:
+        return self.data[:, self.header.index(name)]
+
+
+def _our_series(scene: Scene, out: Path, cache_dir: Path | None) -> _Series:
+    ours = run_scene(
+        scene, output_dir=out, cache_dir=cache_dir, show_progress=False, compare_reference=False
+    )
+    if ours.status != "completed":
+        raise RunError(f"our Jacobi run did not complete: {ours.message}")
+    return _Series(ours.header, ours.data)
+
+
+def agreement(ours: RunResult | _Series, theirs: ToolRun, scene: Scene) -> Agreement:
     """Compare at the communication points both have (our recorded rows on the grid)."""
     times = ours.signal("time")
     k = np.rint((times - scene.start) / scene.master.step).astype(int)
@@ -297,19 +361,19 @@ def crosscheck(
     with tempfile.TemporaryDirectory(prefix="mechcosim-crosscheck-") as scratch:
         if any(o.cannot_run is None for o in outcomes):
             started = time.perf_counter()
-            ours = run_scene(
-                scene,
-                output_dir=Path(scratch) / "ours",
-                cache_dir=cache_dir,
-                show_progress=False,
-                compare_reference=False,
-            )
+            out = Path(scratch) / "ours"
+            try:  # supervised: an FMU that crashes or hangs ends that run only
+                ours = call_supervised(lambda: _our_series(scene, out, cache_dir))
+            except RunError as exc:
+                raise RunError(f"our Jacobi run did not complete: {exc}") from None
             wall = time.perf_counter() - started
-            if ours.status != "completed":
-                raise RunError(f"our Jacobi run did not complete: {ours.message}")
         for o in outcomes:
             if o.cannot_run is None:
-                o.run = run_tool(scene, o.tool, steps, Path(scratch) / o.tool, via, cache_dir)
+                try:
+                    o.run = run_tool(scene, o.tool, steps, Path(scratch) / o.tool, via, cache_dir)
+                except ToolCrashed as exc:
+                    o.cannot_run = str(exc)
+                    continue
                 o.agreement = agreement(ours, o.run, scene)
     return Crosscheck(scene, steps, wall, outcomes)
 

@@ -2,7 +2,9 @@
 
 Each job is (scene file, overrides, results directory).  Workers load the scene, run it
 and send back numbers only (status, headline, statistics, recorded series), so results
-are the same wherever they ran.  FMUs are built once, before the jobs go out.
+are the same wherever they ran.  FMUs are built once, before the jobs go out.  Local
+workers are supervised (``job_workers``): an FMU that crashes, stops or hangs ends its
+job with status "crashed" or "timed out", and the others go on.
 """
 
 from __future__ import annotations
@@ -14,39 +16,14 @@ import sys
 import threading
 from collections.abc import Callable, Iterator
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
+from orchestrator.errors import ScenarioError
 from orchestrator.run import run_scene
 from orchestrator.scenario import load_scene
-
-
-@dataclass(frozen=True)
-class Job:
-    scene: str  # path of the scenario file
-    overrides: dict[str, Any]
-    output_dir: str
-    label: str = ""
-    #: compare with the scene's reference inside the run; a study that shares one
-    #: reference among its jobs computes it once itself and says False
-    compare_reference: bool = True
-    plots: bool = True  # draw the scene analysis's plot
-
-
-@dataclass
-class JobResult:
-    job: Job
-    status: str
-    message: str
-    headline: dict[str, dict[str, Any]]
-    stats: dict[str, Any]
-    header: list[str]
-    data: np.ndarray
-    events: list[tuple[float, str, str, str]]
-    notes: list[str] = field(default_factory=list)  # what the analyses could not compute
+from orchestrator.studies.job_types import Job, JobResult
+from orchestrator.studies.job_workers import can_supervise_jobs, iter_supervised
 
 
 def run_job(job: Job) -> JobResult:
@@ -125,15 +102,23 @@ def iter_jobs(
     """Run ``jobs`` in parallel and yield (index, result) as each finishes, an exception in
     place of the result when the job raised (e.g. a sample its scene refuses).  When
     ``stop()`` turns true no further job starts; those under way still report.  The FMUs
-    must be built beforehand (load the scene once).  One worker runs the jobs in this
-    process (a signal then stops the job under way at a step boundary, as ``run`` does)."""
+    must be built beforehand (load the scene once).  Local jobs run in supervised worker
+    processes (``job_workers``), even with one worker."""
+    if workers is not None and workers < 1:
+        raise ScenarioError(
+            "--workers", "", f"expected a positive number of workers, got {workers}"
+        )
     if not jobs:
         return
     stop = stop or (lambda: False)
     if dask_address:
         yield from _iter_dask(jobs, dask_address, stop)
         return
-    workers = workers or min(len(jobs), os.cpu_count() or 1)
+    workers = min(workers or os.cpu_count() or 1, len(jobs))
+    if can_supervise_jobs():
+        yield from iter_supervised(jobs, workers, stop, run_job)
+        return
+    # Without fork (Windows): unsupervised, as a crash there cannot be survived anyway.
     if workers == 1:  # in this process, one after another: no pool to start
         for k, job in enumerate(jobs):
             if stop():

@@ -162,6 +162,13 @@ FAULTS = (
     "terminate",  # doStep returns fmi2Discard with fmi2Terminated true
     "get_state",  # fmi2GetFMUstate fails
     "instantiate",  # fmi2Instantiate returns NULL
+    "hang",  # doStep never returns
+    "stop",  # doStep raises SIGSTOP
+    "warning",  # doStep logs a warning and returns fmi2Warning
+    "log_warning",  # doStep logs in category logStatusWarning and returns fmi2OK
+    "long_error",  # doStep logs 2000 lines, then 100000 characters, and returns fmi2Error
+    "by_n_sub",  # n_sub 101, 102, 103: segfault, hang, stop; others: no fault
+    "terminate_segfault",  # fmi2Terminate segfaults
 )
 
 

@@ -22,13 +22,23 @@
  *                           (fmi2GetReal fails), FAULT_TERMINATE (doStep returns fmi2Discard
  *                           and fmi2Terminated is true: the model asks to end the simulation);
  *                           and at any time FAULT_GET_STATE (fmi2GetFMUstate fails),
- *                           FAULT_INSTANTIATE (fmi2Instantiate returns NULL)
+ *                           FAULT_INSTANTIATE (fmi2Instantiate returns NULL); from the fault
+ *                           time on also FAULT_HANG (doStep never returns), FAULT_STOP (doStep
+ *                           raises SIGSTOP), FAULT_WARNING (doStep logs a warning and returns
+ *                           fmi2Warning), FAULT_LOG_WARNING (doStep logs in category
+ *                           "logStatusWarning" and returns fmi2OK), FAULT_LONG_ERROR (doStep
+ *                           logs 2000 lines, then one of 100000 characters, and returns
+ *                           fmi2Error), FAULT_BY_N_SUB (n_sub 101, 102, 103 choose
+ *                           FAULT_SEGFAULT, FAULT_HANG, FAULT_STOP; any other runs as built
+ *                           without a fault); and FAULT_TERMINATE_SEGFAULT (fmi2Terminate
+ *                           writes through a null pointer)
  *   TORSION_BODY_FLAGS      if defined, two more outputs: the Boolean body.ahead (vr 0: the
  *                           body's angle is ahead of the flange's) and the String body.label
  *                           (vr 0: "TorsionBody")
  */
 
 #include <math.h>
+#include <signal.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -75,6 +85,13 @@ typedef struct {
 #define FAULT_TERMINATE 5
 #define FAULT_GET_STATE 6
 #define FAULT_INSTANTIATE 7
+#define FAULT_HANG 8
+#define FAULT_STOP 9
+#define FAULT_WARNING 10
+#define FAULT_LOG_WARNING 11
+#define FAULT_LONG_ERROR 12
+#define FAULT_BY_N_SUB 13
+#define FAULT_TERMINATE_SEGFAULT 14
 #ifndef TORSION_BODY_FAULT_TIME
 #define TORSION_BODY_FAULT_TIME 0.0
 #endif
@@ -267,6 +284,12 @@ fmi2Status fmi2Terminate(fmi2Component c) {
     Instance *inst = (Instance *)c;
     if (inst == NULL) return fmi2Error;
     inst->s.mode = MODE_TERMINATED;
+#if defined(TORSION_BODY_FAULT) && TORSION_BODY_FAULT == FAULT_TERMINATE_SEGFAULT
+    {
+        volatile int *volatile nowhere = NULL;
+        *nowhere = 1;
+    }
+#endif
     return fmi2OK;
 }
 
@@ -584,6 +607,7 @@ fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint,
     fmi2Real *r;
     fmi2Real h = communicationStepSize, hs, y, v;
     fmi2Integer i, n;
+    fmi2Status status = fmi2OK; /* fmi2Warning under FAULT_WARNING */
     (void)noSetFMUStatePriorToCurrentPoint;
     if (inst == NULL) return fmi2Error;
     r = inst->s.r;
@@ -617,6 +641,42 @@ fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint,
 #endif
     }
 #endif
+#if defined(TORSION_BODY_FAULT) && TORSION_BODY_FAULT >= FAULT_HANG && \
+    TORSION_BODY_FAULT <= FAULT_BY_N_SUB
+    if (currentCommunicationPoint >= TORSION_BODY_FAULT_TIME - 1e-12) {
+        int fault = TORSION_BODY_FAULT;
+        if (fault == FAULT_BY_N_SUB) {
+            fault = inst->s.n_sub == 101   ? FAULT_SEGFAULT
+                    : inst->s.n_sub == 102 ? FAULT_HANG
+                    : inst->s.n_sub == 103 ? FAULT_STOP
+                                           : 0;
+        }
+        if (fault == FAULT_SEGFAULT) {
+            volatile int *volatile nowhere = NULL;
+            *nowhere = 1;
+        } else if (fault == FAULT_HANG) {
+            volatile unsigned long spin = 0;
+            for (;;) spin++;
+        } else if (fault == FAULT_STOP) {
+            raise(SIGSTOP);
+        } else if (fault == FAULT_WARNING) {
+            log_message(inst, fmi2Warning, "logStatusWarning", "step of %g s larger than advised",
+                        h);
+            status = fmi2Warning;
+        } else if (fault == FAULT_LOG_WARNING) {
+            log_message(inst, fmi2OK, "logStatusWarning", "spring beyond its linear range at t = %g s",
+                        currentCommunicationPoint);
+        } else if (fault == FAULT_LONG_ERROR) {
+            static char line[100001];
+            for (i = 0; i < 2000; i++) log_message(inst, fmi2OK, "logAll", "line %d", (int)i);
+            memset(line, 'x', sizeof line - 1);
+            line[sizeof line - 1] = '\0';
+            inst->cb.logger(inst->cb.componentEnvironment, inst->instance_name, fmi2Error,
+                            "logStatusError", "%s", line);
+            return fmi2Error;
+        }
+    }
+#endif
 
     n = inst->s.n_sub;
     hs = h / n;
@@ -644,7 +704,7 @@ fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint,
     r[VR_W] = r[VR_W_IN] + v;
     inst->s.time = currentCommunicationPoint + h;
     update_outputs(inst);
-    return fmi2OK;
+    return status;
 }
 
 fmi2Status fmi2CancelStep(fmi2Component c) {
