@@ -7,7 +7,7 @@ call has returned; doStep also writes the time it starts from.  The record lives
 memory once ``share`` has been called (``orchestrator.supervisor`` does, before it forks
 the run), and the supervisor reads it when the run's process has died.  That is two stores
 into a memoryview per call (four for doStep), against 1-30 µs for the FMI call itself
-(README, "A crashing FMU").
+(docs/cli.md, "A crashing FMU").
 
 The run also announces itself here (scene, results directory, the longest an FMI call may
 take), so that the supervisor knows where to write the summary of a run that crashed, and

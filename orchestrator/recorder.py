@@ -48,7 +48,7 @@ class Recorder:
         self.rows: list[list[float]] = []
         self.events: list[tuple[float, str, str, str]] = []
         # Line-buffered: each row reaches the file as it is recorded, so a process that
-        # crashes loses at most the step under way (README, "A crashing FMU").
+        # crashes loses at most the step under way (docs/cli.md, "A crashing FMU").
         self._file = open(self.directory / "timeseries.csv", "w", newline="", buffering=1)  # noqa: SIM115
         self._writer = csv.writer(self._file)
         self._writer.writerow(self.header)

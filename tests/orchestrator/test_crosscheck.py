@@ -61,7 +61,7 @@ def test_press_feed_run1_in_libcosim_from_the_osp_file_and_in_fmpy() -> None:
 @pytest.mark.parametrize("via", ["ssp", "osp"])
 @pytest.mark.parametrize("scene_file", ["two_inertias.toml", "m739.toml", "press_feed_run1.toml"])
 def test_default_crosscheck_of_the_three_scenes(scene_file: str, via: str, capsys) -> None:
-    """The command as the README shows it: every tool, the default span."""
+    """The command as docs/fmus_in_other_tools.md shows it: every tool, the default span."""
     assert main(["crosscheck", str(SCENARIOS / scene_file), "--via", via]) == 0
     out = capsys.readouterr().out
     assert out.count(": ok") == 2 and "NOT MET" not in out

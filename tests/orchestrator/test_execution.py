@@ -171,7 +171,7 @@ def test_output_every_thins_the_record_of_every_master(
 
 
 class _HalfStepJacobi:
-    """A master as README's "Adding a master" describes one: Jacobi steps of half
+    """A master as docs/architecture.md's "Adding a master" describes one: Jacobi steps of half
     ``master.step``, with nothing but the stepping."""
 
     def __init__(self, system, scene, stats) -> None:
