@@ -557,18 +557,7 @@ def deck_variables(user: str) -> tuple[Variable, ...]:
 def design_of(component: Any, user: str) -> M739Data:
     """The design a component was given: its deck parameters, the M739's values for the
     quantities it does not take (they do not enter its equations)."""
-    changes: dict[str, Any] = {}
-    for e in DECK:
-        if user not in e.users:
-            continue
-        value = getattr(component, e.name)
-        if e.field == "rpm":
-            value = value * RPM_PER_RAD_S if value != M739.omega else M739.rpm
-        elif e.integer:
-            value = int(value)
-        if value != getattr(M739, e.field):
-            changes[e.field] = value
-    return M739.with_(**changes) if changes else M739
+    return data_from({e.name: getattr(component, e.name) for e in DECK if user in e.users})
 
 
 def data_from(values: dict[str, float]) -> M739Data:
@@ -583,7 +572,8 @@ def data_from(values: dict[str, float]) -> M739Data:
             value = value * RPM_PER_RAD_S if value != M739.omega else M739.rpm
         elif e.integer:
             value = int(value)
-        changes[e.field] = value
+        if value != getattr(M739, e.field):
+            changes[e.field] = value
     return M739.with_(**changes) if changes else M739
 
 

@@ -99,6 +99,7 @@ def test_regime_log_and_outputs(request, scheme) -> None:
     assert 0.0 <= overshoot < 1e-7
 
 
+@pytest.mark.slow  # a second whole run of the scene
 def test_a_coarse_tolerance_stays_accurate(tmp_path, fmu_cache, default_run) -> None:
     # The scene's tolerance: within the report's accuracy (measured 2e-4: turns 2.2e-6).
     # Midpoint hold at tolerance 1e-2: within the same bounds (measured: turns 8.0e-5,

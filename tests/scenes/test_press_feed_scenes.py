@@ -225,6 +225,7 @@ def _stop_time_error(name: str, h: str, cache: Path, tmp: Path) -> float:
     return max(abs(a - b) for a, b in zip(run, ref, strict=True))
 
 
+@pytest.mark.slow  # a convergence study: several runs
 def test_shaft_stop_time_converges(fmu_cache, tmp_path):
     # The roller stops when its speed reaches zero: the stop time carries the roller speed
     # error divided by the deceleration, about 3 macro steps early at every step here
@@ -295,6 +296,7 @@ def _assert_first_order(rows: list[dict], key: str) -> None:
         assert fine < coarse / 1.5, (key, errs)  # halving the step: about half the error
 
 
+@pytest.mark.slow  # a convergence study: several runs
 def test_run1_error_shrinks_with_the_step(fmu_cache, tmp_path):
     rows = _errors(
         "press_feed_run1.toml", ["0.4 ms", "0.2 ms", "0.1 ms"], "0.3 s", fmu_cache, tmp_path
@@ -303,6 +305,7 @@ def test_run1_error_shrinks_with_the_step(fmu_cache, tmp_path):
         _assert_first_order(rows, key)
 
 
+@pytest.mark.slow  # a convergence study: several runs
 def test_decay_ratio_error_shrinks_with_the_step(fmu_cache, tmp_path):
     rows = _errors(
         "sprag_decay_197rpm.toml", ["0.2 ms", "0.1 ms", "0.05 ms"], None, fmu_cache, tmp_path

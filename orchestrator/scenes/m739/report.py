@@ -36,21 +36,12 @@ from orchestrator.plotting import (
 )
 from orchestrator.scenario import Scene
 from orchestrator.scenes.family import Quantity, Reference, quantity
-from orchestrator.scenes.m739.design import scene_design
+from orchestrator.scenes.m739.design import instances, parameter, scene_design
 from orchestrator.scenes.m739.monolithic import run_m739
 
-
-def instance_names(scene: Scene) -> tuple[str, str]:
-    """(gear train, verge) instances, from [report.options]."""
-    o = scene.report_options
-    return o.get("train", "train"), o.get("verge", "verge")
-
-
-def _parameter(scene: Scene, instance: str, name: str) -> float:
-    spec = scene.fmus[instance]
-    if name in spec.parameters:
-        return spec.parameters[name]
-    return scene.component_class(instance).variable(name).start
+#: (gear train, verge) instances of a scene, and a parameter of one of its FMUs as run.
+instance_names = instances
+_parameter = parameter
 
 
 def escapement_arguments(scene: Scene, train: str, verge: str) -> dict[str, float]:
