@@ -12,6 +12,7 @@ import atexit
 import hashlib
 import itertools
 import shutil
+import struct
 from collections.abc import Callable
 from ctypes import byref
 from pathlib import Path
@@ -372,6 +373,54 @@ class FmuInstance:
 
     def free_state(self, state: Any) -> None:
         self._free_state(self.fmu.component, byref(state))
+
+    def restore_fault(self, step: Callable[[], None]) -> str | None:
+        """Whether restoring a saved state reproduces a step, as a master's rollback needs:
+        save the state, take ``step``, read the outputs (and the serialized state, where
+        the FMU can serialize), restore, take it again, compare bit for bit.  None where
+        both agree, else what differs.  The FMU is left in the saved state."""
+        outputs = [v for v in self.model_description.modelVariables if v.causality == "output"]
+        reals = [v for v in outputs if v.type == "Real"]
+        ints = [v for v in outputs if v.type in ("Integer", "Enumeration", "Boolean")]
+        serializes = bool(self.model_description.coSimulation.canSerializeFMUstate)
+        time_word = self._flight.reals[flight.TIME]  # the check moves no one's time
+
+        def taken() -> tuple[list[float], list[int], bytes]:
+            step()
+            real_values = self.fmu.getReal([v.valueReference for v in reals]) if reals else []
+            int_values = [
+                self.fmu.getBoolean([v.valueReference])[0]
+                if v.type == "Boolean"
+                else self.fmu.getInteger([v.valueReference])[0]
+                for v in ints
+            ]
+            serialized = b""
+            if serializes:
+                after = self.get_state()
+                try:
+                    serialized = self.fmu.serializeFMUstate(after)
+                finally:
+                    self.free_state(after)
+            return real_values, int_values, serialized
+
+        saved = self.get_state()
+        try:
+            first = taken()
+            self.set_state(saved)
+            second = taken()
+        finally:
+            self.set_state(saved)
+            self.free_state(saved)
+            self._flight.reals[flight.TIME] = time_word
+        for v, a, b in zip(reals, first[0], second[0], strict=True):
+            if struct.pack("<d", a) != struct.pack("<d", b):
+                return f"output {v.name} differs by {b - a:.3g} ({a!r} then {b!r})"
+        for v, a, b in zip(ints, first[1], second[1], strict=True):
+            if a != b:
+                return f"output {v.name} differs ({a} then {b})"
+        if first[2] != second[2]:
+            return "its serialized state differs"
+        return None
 
     def close(self) -> None:
         if self.fmu is None:

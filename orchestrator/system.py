@@ -6,6 +6,7 @@ per target.  Masters use only this interface, so they never deal with names.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -51,6 +52,8 @@ class CoupledSystem:
         self.connections = scene.connections
         self.instances: list[FmuInstance] = []
         paths = {n: spec.path for n, spec in scene.fmus.items()} | (fmu_paths or {})
+        self.paths: dict[str, Path] = paths
+        self.tolerance: float | None = None  # the integration tolerance asked of the FMUs
         try:
             for name in self.names:
                 self.instances.append(FmuInstance(name, paths[name]))
@@ -169,6 +172,7 @@ class CoupledSystem:
         """Instantiate every FMU with its parameters and start values; ``tolerance``: the
         integration tolerance the master asks of the FMUs (None: their own)."""
         scene = self.scene
+        self.tolerance = tolerance
         for inst in self.instances:
             spec = scene.fmus[inst.name]
             values = {**spec.parameters, **spec.inputs}
@@ -314,6 +318,49 @@ class CoupledSystem:
         a caller that feeds them given values and steps or reads them next."""
         for inst, s in zip(self.instances, state, strict=True):
             inst.set_state(s)
+
+    def restore_faults(self, t: float, h: float) -> dict[str, str]:
+        """The FMUs, not ours (ours carry our vendor annotation and restore bit for bit),
+        that save and restore their state but whose restore does not reproduce a step of h
+        from t: instance name -> what differs (``FmuInstance.restore_fault``).  Each is
+        checked on a twin, initialized and fed as it is: a faulty restore could not leave
+        the instance itself as it was."""
+        faults = {}
+        for i, (name, model) in enumerate(zip(self.names, self.models, strict=True)):
+            if model.annotated or not model.can_get_set_state:
+                continue
+            twin = FmuInstance(name, self.paths[name])
+            try:
+                fault = twin.restore_fault(self._twin_step(i, twin, t, h))
+            finally:
+                twin.close()
+            if fault is not None:
+                faults[name] = fault
+        return faults
+
+    def _twin_step(self, i: int, twin: FmuInstance, t: float, h: float) -> Callable[[], None]:
+        """Initialize ``twin`` like instance i, give it the inputs instance i holds now, and
+        return its step of h from t, driven by the scene's signals as ``step`` drives."""
+        spec = self.scene.fmus[self.names[i]]
+        twin.initialize(
+            self.scene.start, self.scene.stop, {**spec.parameters, **spec.inputs}, self.tolerance
+        )
+        feed = self.feeds[i]
+        if feed.real_refs:
+            twin.set_real(feed.real_refs, [self.values[s][k] for s, k in feed.real_sources])
+        if feed.int_refs:
+            twin.fmu.setInteger(feed.int_refs, [self.ints[s][k] for s, k in feed.int_sources])
+        driven = [(v, sig) for (n, v), sig in self.signals.driven.items() if n == self.names[i]]
+        set_driven = twin.setter(twin.refs([v for v, _ in driven])) if driven else None
+
+        def step() -> None:
+            if set_driven is not None:
+                set_driven([sig.value(t) for _, sig in driven])
+            twin.do_step(t, h)
+            if set_driven is not None:
+                set_driven([sig.value(t + h) for _, sig in driven])
+
+        return step
 
     def free_state(self, state: list[Any]) -> None:
         for inst, s in zip(self.instances, state, strict=True):

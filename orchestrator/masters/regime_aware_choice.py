@@ -2,7 +2,8 @@
 "extrapolated"``), the midpoint-hold master (``"midpoint"``; ``"start"`` its first-order
 form), by default (``"auto"``) the single pass where an FMU reports its own copy of a
 partner's state and the midpoint hold elsewhere; or fixed-step Jacobi where an FMU cannot
-save and restore its state (no trial could be taken back)."""
+save and restore its state, or whose restore does not reproduce a step (no trial could be
+taken back)."""
 
 from __future__ import annotations
 
@@ -26,16 +27,28 @@ def regime_aware(system: CoupledSystem, scene: Scene, stats: StepStats) -> Maste
     cannot_save = [
         n for n, m in zip(system.names, system.models, strict=True) if not m.can_get_set_state
     ]
+    fixed = (
+        f"fixed-step Jacobi in steps of {scene.master.step:g} s (no error control, switches "
+        "seen only at communication points)"
+    )
     if cannot_save:
         # Without rollback no trial can be taken back: say what is given up, and couple
         # the way every tool can.
         stats.extra.setdefault("warnings", []).append(
             f"FMU {', '.join(map(repr, cannot_save))} cannot save and restore its state "
             "(canGetAndSetFMUstate is false), which the regime-aware master needs to reject "
-            "steps and to land on switches: it gives both up and runs fixed-step Jacobi in "
-            f"steps of {scene.master.step:g} s (no error control, switches seen only "
-            "at communication points)"
+            f"steps and to land on switches: it gives both up and runs {fixed}"
         )
+        return fixed_step_master(system, scene, stats, scene.master.step, sequential=False)
+    # A restore that does not reproduce a step would make every rollback change the
+    # answer: such an FMU is not rolled back, and no FMU is, as no trial could be retaken.
+    faults = system.restore_faults(scene.start, scene.master.settings.first_step)
+    if faults:
+        for name, fault in faults.items():
+            stats.extra.setdefault("warnings", []).append(
+                f"FMU {name!r}: restoring its state does not reproduce its step ({fault}): "
+                f"it is not rolled back; the regime-aware master runs {fixed}"
+            )
         return fixed_step_master(system, scene, stats, scene.master.step, sequential=False)
     settings = replace(scene.master.settings, input_hold=input_hold(system, scene))
     stats.extra["input_hold"] = settings.input_hold

@@ -550,16 +550,19 @@ PI_CONTROLLER_VARIABLES = (
 )
 
 
-def build_pi_controller(dest: Path) -> Path:
+def build_pi_controller(dest: Path, forgets_integrator: bool = False) -> Path:
     """Compile PiController (its initialization fails unless the set point u_s is 0) and
-    pack it as ``dest/PiController.fmu``; return its path."""
+    pack it as ``dest/PiController.fmu``; return its path.  ``forgets_integrator``: its
+    fmi2SetFMUstate restores everything but the integral x (``PiController-forgets.fmu``),
+    a state restore that does not reproduce a step."""
+    suffix = "-forgets" if forgets_integrator else ""
     return _build_c_fmu(
         PI_CONTROLLER_SOURCE,
         "PiController",
         "PI_CONTROLLER_GUID",
-        [],
+        ["-DPI_CONTROLLER_FORGETS_INTEGRATOR"] if forgets_integrator else [],
         _pi_controller_model_description,
-        Path(dest) / "PiController.fmu",
+        Path(dest) / f"PiController{suffix}.fmu",
     )
 
 
