@@ -130,6 +130,7 @@ def test_without_the_check_the_rollbacks_change_the_answer(
     assert speed_error(ours) > 1e-3
 
 
+@pytest.mark.slow  # about 11 s: the master takes some 70,000 steps on this loop
 def test_a_faithful_foreign_fmu_is_still_rolled_back(
     controllers: tuple[Path, Path], tmp_path: Path
 ) -> None:
