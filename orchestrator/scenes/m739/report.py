@@ -154,11 +154,16 @@ def monolithic_arguments(scene: Scene) -> dict[str, Any]:
 def reference(scene: Scene) -> Reference:
     """The monolithic M739 model with the scene's physics and design, as the yardstick."""
     train, verge = instance_names(scene)
-    return reference_from(run_m739(**monolithic_arguments(scene)), train, verge)
+    result = run_m739(**monolithic_arguments(scene))
+    return reference_from(result, train, verge, train_regimes=TRAIN_REGIME_NAMES)
 
 
-def reference_from(result: Any, train: str, verge: str) -> Reference:
-    """A Reference from a monolithic verge-and-train result (``M739Result``)."""
+def reference_from(
+    result: Any, train: str, verge: str, train_regimes: dict[int, str] | None = None
+) -> Reference:
+    """A Reference from a monolithic verge-and-train result (``M739Result``); with
+    ``train_regimes`` (the train FMU's regime names), the train's reversals are among its
+    events too, as that FMU logs them."""
     s = result.series
     headline = {
         "F23_max": result.f23_max,
@@ -187,10 +192,11 @@ def reference_from(result: Any, train: str, verge: str) -> Reference:
     ]
     # The train's reversals and sticks, as the train FMU logs them (an impact with rebound
     # throws the wheel back).
-    events += [
-        (te, train, TRAIN_REGIME_NAMES.get(a, str(a)), TRAIN_REGIME_NAMES.get(b, str(b)))
-        for te, a, b in getattr(result, "train_log", ())
-    ]
+    if train_regimes is not None:
+        events += [
+            (te, train, train_regimes.get(a, str(a)), train_regimes.get(b, str(b)))
+            for te, a, b in getattr(result, "train_log", ())
+        ]
     events.sort(key=lambda e: e[0])
     return Reference(headline=headline, signals=signals, events=events, t_range=t_range)
 
