@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import csv
 from collections.abc import Iterable, Sequence
+from functools import cache
 from pathlib import Path
 from typing import Any
 
@@ -24,8 +25,10 @@ BAND_COLOURS = ("#dddddd", "#9ecae1", "#fdae6b", "#a1d99b", "#bcbddc", "#fc9272"
 Event = tuple[float, str, str, str]  # (time, subsystem, from, to), as events.csv holds them
 
 
+@cache
 def pyplot() -> Any:
-    """matplotlib's pyplot, drawing to files only."""
+    """matplotlib's pyplot, drawing to files only (imported, and its backend chosen, once:
+    only a run that plots pays for it)."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -202,11 +205,12 @@ def window(t: np.ndarray, start: float, end: float) -> np.ndarray:
     return (t >= start) & (t <= end)
 
 
-def save_figure(fig: Any, path: Path, title: str | None = None) -> None:
-    """Title, tight layout, PNG at ``path``, figure closed."""
+def save_figure(fig: Any, path: Path, title: str | None = None, tight: bool = True) -> None:
+    """Title, tight layout (``tight``: a figure laid out by hand has none), PNG at ``path``,
+    figure closed."""
     if title:
         fig.suptitle(title)
-    if fig.get_layout_engine() is None:  # a figure made with a layout keeps it
+    if tight and fig.get_layout_engine() is None:  # a figure made with a layout keeps it
         fig.tight_layout()
     fig.savefig(path, dpi=110)
     pyplot().close(fig)
