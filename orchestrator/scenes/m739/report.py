@@ -233,9 +233,8 @@ def escapement_plot(
     # times over to place it: most of the plot's cost): legends stand right of the axes.
     width, height = 11.0, 15.0 + 1.8 * panels
     fig = plt.figure(figsize=(width, height))
-    shares = (3.6, 4.8 + 1.4 * panels)
-    top, bottom = fig.subfigures(2, 1, height_ratios=shares)
-    top_height = height * shares[0] / sum(shares)
+    top_height = 6.4  # the whole run, whatever the detail panels below
+    top, bottom = fig.subfigures(2, 1, height_ratios=(top_height, height - top_height))
     verge_colours = regime_colours(regime_names(scene, verge))
     overview = _margins(width, top_height, top=1.2, bottom=0.55, hspace=0.12)
     _overview(top, scene, t, phi, col[f"{train}.phi_dot"], pitch, impacts, t_arm, detail_end,
