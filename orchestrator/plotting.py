@@ -205,12 +205,11 @@ def window(t: np.ndarray, start: float, end: float) -> np.ndarray:
     return (t >= start) & (t <= end)
 
 
-def save_figure(fig: Any, path: Path, title: str | None = None, tight: bool = True) -> None:
-    """Title, tight layout (``tight``: a figure laid out by hand has none), PNG at ``path``,
-    figure closed."""
+def save_figure(fig: Any, path: Path, title: str | None = None) -> None:
+    """Title, tight layout, PNG at ``path``, figure closed."""
     if title:
         fig.suptitle(title)
-    if tight and fig.get_layout_engine() is None:  # a figure made with a layout keeps it
+    if fig.get_layout_engine() is None:  # a figure made with a layout keeps it
         fig.tight_layout()
     fig.savefig(path, dpi=110)
     pyplot().close(fig)
