@@ -140,6 +140,7 @@ def _write(path: Path, ref: Reference) -> None:
         fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".tmp")
         with os.fdopen(fd, "wb") as f:
             f.write(data)
+        os.chmod(tmp, 0o666 & ~_umask())  # as any file written here (mkstemp's is 0600)
         os.replace(tmp, path)
     except Exception:  # noqa: BLE001 - the cache only saves time: the run goes on without
         with contextlib.suppress(Exception):
@@ -166,3 +167,9 @@ def _function(state: dict[str, Any]) -> Callable:
     return types.FunctionType(
         marshal.loads(state["code"]), module.__dict__, state["name"], state["defaults"], closure
     )
+
+
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
