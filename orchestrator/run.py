@@ -32,6 +32,7 @@ from orchestrator.interrupt import Interrupted, SignalGuard, catching_signals, s
 from orchestrator.masters.regime_aware_choice import fmu_tolerance
 from orchestrator.observers import EnergyBalance
 from orchestrator.output_lock import OutputLock
+from orchestrator.plotting import pyplot
 from orchestrator.progress import ProgressBar
 from orchestrator.provenance import source_commit
 from orchestrator.recorder import Recorder, StepStats
@@ -312,8 +313,11 @@ def _analyse(
     analysis.__exit__(None, None, None)
     plotted = scene.family in PLOTS and options.plots and len(data) > 1
     if scene.family and status == "completed" and plotted:
-        with phases.timed("plot"), _noted(notes, f"plot of {scene.family!r}", header):
-            PLOTS[scene.family](scene, header, data, out / f"{scene.name}.png")
+        with _noted(notes, f"plot of {scene.family!r}", header):
+            with phases.timed("plot: import matplotlib"):
+                pyplot()  # once a process: told apart from the drawing
+            with phases.timed("plot: draw and write the PNG"):
+                PLOTS[scene.family](scene, header, data, out / f"{scene.name}.png")
     accuracy: dict[str, float] = {}
     ref = None
     if scene.reference and status == "completed" and options.compare_reference:
