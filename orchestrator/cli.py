@@ -40,6 +40,12 @@ def main(argv: list[str] | None = None) -> int:
     )
     p.add_argument("--output", type=Path, help="results directory (default: the scene's)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    p.add_argument("--no-plot", action="store_true", help="no PNG of the run")
+    p.add_argument(
+        "--no-reference",
+        action="store_true",
+        help="no comparison with the scene's reference (no accuracy in the summary)",
+    )
     p.add_argument(
         "--force", action="store_true", help="run even a scene of more than 1e8 macro steps"
     )
@@ -284,6 +290,7 @@ def _run(args: argparse.Namespace) -> int:
     from orchestrator.interrupt import catching_signals
     from orchestrator.supervisor import can_supervise, supervised
 
+    args.started_up = _since_process_start()  # here: a supervised run's child starts anew
     # From here on SIGINT/SIGTERM only set a flag: the run stops at a step boundary.
     with catching_signals() as guard:
         if args.in_process or not can_supervise():
@@ -301,12 +308,27 @@ def _run(args: argparse.Namespace) -> int:
 
 
 def _run_guarded(args: argparse.Namespace) -> int:
+    import time
+
+    started_up = getattr(args, "started_up", None) or _since_process_start()
+    phases: dict[str, float] = {"start-up (interpreter, command line)": started_up}
+    start = time.perf_counter()
     from orchestrator.cache import check_cache_dir
     from orchestrator.run import run_scene
 
+    phases["imports"] = time.perf_counter() - start
+    start = time.perf_counter()
     check_cache_dir()
     scene = _load(args.scene, _overrides(args.set), args.force)
-    result = run_scene(scene, output_dir=args.output, show_progress=not args.no_progress)
+    phases["scene load"] = time.perf_counter() - start
+    result = run_scene(
+        scene,
+        output_dir=args.output,
+        show_progress=not args.no_progress,
+        plots=not args.no_plot,
+        compare_reference=not args.no_reference,
+    )
+    phases.update(result.phases)
     summary = {
         "scene": scene.name,
         "status": result.status,
@@ -318,7 +340,34 @@ def _run_guarded(args: argparse.Namespace) -> int:
         "stats": result.stats.as_dict(),
     }
     print("\n".join(summary_lines(summary, result.output_dir)))
+    if args.debug:
+        sys.stdout.flush()
+        _print_phases(phases)
     return 0 if result.status == "completed" else 1
+
+
+def _since_process_start() -> float:
+    """Wall time [s] since this process started (Linux: /proc; elsewhere NaN)."""
+    import os
+
+    try:
+        with open("/proc/self/stat") as f:
+            ticks = int(f.read().rpartition(")")[2].split()[19])
+        with open("/proc/uptime") as f:
+            uptime = float(f.read().split()[0])
+        return uptime - ticks / os.sysconf("SC_CLK_TCK")
+    except (OSError, ValueError, IndexError):
+        return math.nan
+
+
+def _print_phases(phases: dict[str, float]) -> None:
+    """One line a phase, its wall time, on standard error (``--debug``)."""
+    width = max(len(name) for name in phases)
+    print("phases (wall time):", file=sys.stderr)
+    for name, seconds in phases.items():
+        print(f"  {name:<{width}}  {seconds:8.3f} s", file=sys.stderr)
+    total = sum(v for v in phases.values() if not math.isnan(v))
+    print(f"  {'total':<{width}}  {total:8.3f} s", file=sys.stderr)
 
 
 def _load(path: Path, overrides: dict, force: bool):  # noqa: ANN202 - a Scene

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import csv
 from collections.abc import Iterable, Sequence
+from functools import cache
 from pathlib import Path
 from typing import Any
 
@@ -24,8 +25,10 @@ BAND_COLOURS = ("#dddddd", "#9ecae1", "#fdae6b", "#a1d99b", "#bcbddc", "#fc9272"
 Event = tuple[float, str, str, str]  # (time, subsystem, from, to), as events.csv holds them
 
 
+@cache
 def pyplot() -> Any:
-    """matplotlib's pyplot, drawing to files only."""
+    """matplotlib's pyplot, drawing to files only (imported, and its backend chosen, once:
+    only a run that plots pays for it)."""
     import matplotlib
 
     matplotlib.use("Agg")

@@ -20,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from fmus.build import build_fmu
+from fmus.build import build_fmu, default_cache_dir
 from orchestrator.accuracy import compare
 from orchestrator.analyses import energy_residual, headline, missing_column
 from orchestrator.errors import RunError
@@ -32,9 +32,11 @@ from orchestrator.interrupt import Interrupted, SignalGuard, catching_signals, s
 from orchestrator.masters.regime_aware_choice import fmu_tolerance
 from orchestrator.observers import EnergyBalance
 from orchestrator.output_lock import OutputLock
+from orchestrator.plotting import pyplot
 from orchestrator.progress import ProgressBar
 from orchestrator.provenance import source_commit
 from orchestrator.recorder import Recorder, StepStats
+from orchestrator.reference_cache import cached_reference
 from orchestrator.scenario import Scene
 from orchestrator.scenes import ANALYSES, PLOTS, REFERENCES
 from orchestrator.scenes.family import Reference
@@ -60,6 +62,8 @@ class RunResult:
     notes: list[str] = field(default_factory=list)  # what could not be computed, and why
     interrupted_by: int | None = None  # the signal that interrupted the run
     reference: Reference | None = None  # the reference the run was compared with, if any
+    #: wall time [s] of each phase of the run, in the order run (``--debug`` prints them)
+    phases: dict[str, float] = field(default_factory=dict)
 
     def signal(self, name: str) -> np.ndarray:
         """Recorded column by name ('time' or '<instance>.<variable>')."""
@@ -76,16 +80,41 @@ def run_scene(
     show_progress: bool = True,
     compare_reference: bool = True,
     plots: bool = True,
+    reference_cache: bool = True,
 ) -> RunResult:
     """Run ``scene`` and write its results under ``output_dir`` (default: the scene's).
 
     The directory is locked for the run (``OutputInUseError`` if another run holds it).
     SIGINT/SIGTERM stop the run at the next step boundary with status "interrupted".
+    ``reference_cache``: read the reference from, and keep it in, the FMU cache directory
+    (``orchestrator.reference_cache``).
     """
     out = Path(output_dir) if output_dir else scene.output_dir
+    options = _Options(compare_reference, plots, cache_dir, reference_cache, Phases())
     with catching_signals() as guard, OutputLock(out):
         announce_run(scene, out)  # for a supervisor, should this process crash
-        return _run_locked(scene, out, cache_dir, show_progress, compare_reference, plots, guard)
+        return _run_locked(scene, out, cache_dir, show_progress, options, guard)
+
+
+class Phases(dict):
+    """Wall time [s] by phase name, in the order the phases ran."""
+
+    @contextmanager
+    def timed(self, name: str) -> Iterator[None]:
+        start = time.perf_counter()
+        try:
+            yield
+        finally:
+            self[name] = self.get(name, 0.0) + time.perf_counter() - start
+
+
+@dataclass
+class _Options:
+    compare_reference: bool
+    plots: bool
+    cache_dir: Path | None
+    reference_cache: bool
+    phases: Phases
 
 
 def _run_locked(
@@ -93,16 +122,17 @@ def _run_locked(
     out: Path,
     cache_dir: Path | None,
     show_progress: bool,
-    compare_reference: bool,
-    plots: bool,
+    options: _Options,
     guard: SignalGuard,
 ) -> RunResult:
-    fmu_paths = fmu_files(scene, cache_dir)
-    try:
-        system = CoupledSystem(scene, fmu_paths)
-    except RunError as exc:  # an FMU that cannot be instantiated: say so in the results too
-        write_summary(out, not_started_summary(scene, str(exc)))
-        raise
+    phases = options.phases
+    with phases.timed("FMUs: build/find, extract, instantiate"):
+        fmu_paths = fmu_files(scene, cache_dir)
+        try:
+            system = CoupledSystem(scene, fmu_paths)
+        except RunError as exc:  # an FMU that cannot be instantiated: say so in the results
+            write_summary(out, not_started_summary(scene, str(exc)))
+            raise
     try:
         recorder = Recorder(out, system.record_header)
     except OSError as exc:
@@ -110,7 +140,8 @@ def _run_locked(
         raise RunError(f"cannot write results in {out}: {exc.strerror or exc}") from None
     stats = StepStats()
     energy = EnergyBalance(system, recorder.header)
-    meta = _metadata(scene, fmu_paths)
+    with phases.timed("metadata (FMU hashes, versions, commit)"):
+        meta = _metadata(scene, fmu_paths)
     bar = ProgressBar(
         total=scene.stop - scene.start,
         unit="s(sim)",
@@ -133,11 +164,12 @@ def _run_locked(
     start = time.perf_counter()
     try:
         return _stepped(scene, out, system, recorder, stats, energy, meta, guard, progress,
-                        reached, bar, start, compare_reference, plots)  # fmt: skip
+                        reached, bar, start, options)  # fmt: skip
     finally:
         # Last: an FMU that crashes as it is terminated or freed (README, "A crashing FMU")
         # then finds the run's summary written, headline and all.
-        system.close()
+        with phases.timed("close FMUs"):
+            system.close()
 
 
 def _stepped(
@@ -153,13 +185,15 @@ def _stepped(
     reached: list[float],
     bar: ProgressBar,
     start: float,
-    compare_reference: bool,
-    plots: bool,
+    options: _Options,
 ) -> RunResult:
     """Step ``system`` to the end, then analyse, summarize and return the run (the FMUs
     stay alive: the caller closes them)."""
     status, message = "completed", ""
     notes: list[str] = []
+    phases = options.phases
+    cosim = phases.timed("co-simulation (initialize, step)")
+    cosim.__enter__()
     try:
         guard.check()
         system.initialize(fmu_tolerance(system, scene))
@@ -181,6 +215,7 @@ def _stepped(
     finally:
         stats.wall_time = time.perf_counter() - start
         bar.close()
+        cosim.__exit__(None, None, None)
     warned = fmu_warnings(system)
     for fmu, log in warned.items():
         notes.extend(log.notes(fmu))
@@ -193,7 +228,7 @@ def _stepped(
         # No FMU is called any more: a signal may now stop the analyses where it lands.
         with guard.raise_at_once(), _without_numeric_warnings():
             quantities, accuracy, ref = _analyse(
-                scene, out, recorder, data, energy, status, compare_reference, plots, notes
+                scene, out, recorder, data, energy, status, options, notes
             )
     except Interrupted as exc:
         if status == "completed":
@@ -202,6 +237,8 @@ def _stepped(
     if guard.signum is not None and status == "completed":
         status = "interrupted"
         message = f"interrupted by {signal_name(guard.signum)} after the run ended"
+    summary_phase = phases.timed("summary")
+    summary_phase.__enter__()
     recorder.close(
         {
             "scene": scene.name,
@@ -218,6 +255,7 @@ def _stepped(
         }
     )
     summary_written()  # for a supervisor, should closing an FMU crash this process
+    summary_phase.__exit__(None, None, None)
     return RunResult(
         scene=scene,
         status=status,
@@ -234,6 +272,7 @@ def _stepped(
         notes=notes,
         interrupted_by=guard.signum if status == "interrupted" else None,
         reference=ref,
+        phases=phases,
     )
 
 
@@ -244,15 +283,17 @@ def _analyse(
     data: np.ndarray,
     energy: EnergyBalance,
     status: str,
-    compare_reference: bool,
-    plots: bool,
+    options: _Options,
     notes: list[str],
 ) -> tuple[dict[str, dict[str, Any]], dict[str, float], Reference | None]:
     """Headline, energy residual, scene analysis, plot and error against the reference
     (returned with them): each that fails adds a note saying why, and the others still
     count."""
     header = recorder.header
+    phases = options.phases
     quantities: dict[str, dict[str, Any]] = {}
+    analysis = phases.timed("headline, energy, analysis")
+    analysis.__enter__()
     with _noted(notes, "headline quantities", header):
         quantities.update(headline(scene, header, data))
     with _noted(notes, "energy residual", header):
@@ -269,15 +310,30 @@ def _analyse(
     if scene.family and status == "completed":
         with _noted(notes, f"analysis {scene.family!r}", header):
             quantities.update(ANALYSES[scene.family](scene, header, data, scene.report_options))
-        if plots and scene.family in PLOTS and len(data) > 1:
-            with _noted(notes, f"plot of {scene.family!r}", header):
+    analysis.__exit__(None, None, None)
+    plotted = scene.family in PLOTS and options.plots and len(data) > 1
+    if scene.family and status == "completed" and plotted:
+        with _noted(notes, f"plot of {scene.family!r}", header):
+            with phases.timed("plot: import matplotlib"):
+                pyplot()  # once a process: told apart from the drawing
+            with phases.timed("plot: draw and write the PNG"):
                 PLOTS[scene.family](scene, header, data, out / f"{scene.name}.png")
     accuracy: dict[str, float] = {}
     ref = None
-    if scene.reference and status == "completed" and compare_reference:
+    if scene.reference and status == "completed" and options.compare_reference:
         with _noted(notes, f"reference {scene.reference!r}", header):
-            ref = reference_of(scene)
-            accuracy = compare(header, data, recorder.events, quantities, ref, notes)
+            hit = False
+            with phases.timed("reference"):
+                if options.reference_cache:
+                    ref, hit = cached_reference(
+                        scene, reference_of, options.cache_dir or default_cache_dir()
+                    )
+                else:
+                    ref = reference_of(scene)
+            if hit:  # said in the phase list only: the summary stays that of a computed one
+                phases["reference (from the cache)"] = phases.pop("reference")
+            with phases.timed("accuracy against the reference"):
+                accuracy = compare(header, data, recorder.events, quantities, ref, notes)
             accuracy["reference_wall_time"] = ref.wall_time
     return quantities, accuracy, ref
 

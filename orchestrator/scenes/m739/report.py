@@ -226,6 +226,8 @@ def escapement_plot(
     armed).  ``extra(axes, ms, col)`` draws on further detail panels (as many as its
     ``panels`` attribute says)."""
     plt = pyplot()
+    from matplotlib.layout_engine import PlaceHolderLayoutEngine  # a plot's import only
+
     train, verge = instance_names(scene)
     col = {name: data[:, i] for i, name in enumerate(header)}
     t = col["time"]
@@ -235,13 +237,28 @@ def escapement_plot(
     impacts = _impacts(events, verge, t, col[f"{verge}.impact_count"])
     detail_end = crossing_time(t, phi - phi[0], DETAIL_TEETH * pitch) or float(t[-1])
     panels = getattr(extra, "panels", 0)
-    fig = plt.figure(figsize=(11, 15 + 1.8 * panels), layout="constrained")
-    top, bottom = fig.subfigures(2, 1, height_ratios=(3.2, 5.2 + 1.4 * panels))
+    # A fixed layout, in inches from the edges (a layout engine draws the figure several
+    # times over to place it: most of the plot's cost): legends stand right of the axes.
+    width, height = 11.0, 15.0 + 1.8 * panels
+    fig = plt.figure(figsize=(width, height))
+    fig.set_layout_engine(PlaceHolderLayoutEngine(True, True))  # laid out here: no tight layout
+    top_height = 6.4  # the whole run, whatever the detail panels below
+    top, bottom = fig.subfigures(2, 1, height_ratios=(top_height, height - top_height))
     verge_colours = regime_colours(regime_names(scene, verge))
-    _overview(top, scene, t, phi, col[f"{train}.phi_dot"], pitch, impacts, t_arm, detail_end)
+    overview = _margins(width, top_height, top=1.2, bottom=0.55, hspace=0.12)
+    _overview(top, scene, t, phi, col[f"{train}.phi_dot"], pitch, impacts, t_arm, detail_end,
+              overview)  # fmt: skip
     _impact_bars(top.axes[2], t, phi, pitch, impacts, verge_colours)
+    fig.suptitle(title, y=1.0 - 0.12 / height, va="top")
+    top.suptitle("whole run", y=1.0 - 0.42 / top_height, va="top")
     heights = (0.5, 1, 1, 1.2, 1, *(1.1,) * panels)
-    axes = bottom.subplots(len(heights), 1, sharex=True, height_ratios=heights)
+    axes = bottom.subplots(
+        len(heights),
+        1,
+        sharex=True,
+        height_ratios=heights,
+        gridspec_kw=_margins(width, height - top_height, top=0.55, bottom=0.55, hspace=0.25),
+    )
     sel = window(t, t[0], detail_end)
     ms, cols = 1e3 * t[sel], {name: v[sel] for name, v in col.items()}
     rows = []
@@ -267,7 +284,8 @@ def escapement_plot(
     release = [ti for ti in release if ti <= detail_end]
     event_lines(axes[1:], release, 1e3, colour="0.45", style="--", width=0.7)
     event_lines(axes[1:], hit, 1e3, colour="C3", width=1.0)
-    bottom.suptitle(f"the first {DETAIL_TEETH} teeth in detail")
+    detail_title = 1.0 - 0.15 / (height - top_height)
+    bottom.suptitle(f"the first {DETAIL_TEETH} teeth in detail", y=detail_title, va="top")
     axes[1].set_title(
         "recorded values as dots; red lines: impacts, "
         "dashed: the verge leaves the tooth (located times, events.csv)",
@@ -278,7 +296,22 @@ def escapement_plot(
         ax.grid(True, alpha=0.3)
     axes[-1].set_xlabel("time [ms]")
     axes[-1].set_xlim(1e3 * t[0], 1e3 * detail_end)
-    save_figure(fig, path, title)
+    bottom.align_ylabels(axes)
+    save_figure(fig, path)
+
+
+def _margins(
+    width: float, height: float, top: float, bottom: float, hspace: float
+) -> dict[str, float]:
+    """Grid parameters of a panel of ``width`` x ``height`` inches: ``top`` and ``bottom``
+    margins in inches, room for the y labels left and the legends right."""
+    return {
+        "left": 0.95 / width,
+        "right": 1.0 - 1.95 / width,
+        "top": 1.0 - top / height,
+        "bottom": bottom / height,
+        "hspace": hspace,
+    }
 
 
 def _impacts(events: list, verge: str, t: np.ndarray, count: np.ndarray) -> list[tuple[float, str]]:
@@ -338,10 +371,11 @@ def _overview(
     impacts: list[tuple[float, str]],
     t_arm: float | None,
     detail_end: float,
+    grid: dict[str, float],
 ) -> None:
     """Escape-wheel turns against time up to arming, its speed (recorded, and the mean over
-    each tooth), impacts per tooth by pallet."""
-    axes = fig.subplots(3, 1, sharex=True, height_ratios=(1.4, 1, 0.8))
+    each tooth), impacts per tooth by pallet; ``grid``: the panel's margins."""
+    axes = fig.subplots(3, 1, sharex=True, height_ratios=(1.4, 1, 0.8), gridspec_kw=grid)
     ms = 1e3 * t
     axes[0].plot(ms, phi / (2.0 * math.pi), color="C0", lw=1.2, label="escape wheel")
     unit_label(axes[0], "escape-wheel angle", "turn")
@@ -382,4 +416,3 @@ def _overview(
         ax.axvspan(1e3 * t[0], 1e3 * detail_end, color="0.9", zorder=0)
         ax.grid(True, alpha=0.3)
     axes[0].text(1e3 * detail_end, 0.0, " detail below", fontsize=8, va="bottom", color="0.4")
-    fig.suptitle("whole run")
