@@ -244,6 +244,7 @@ def test_a_resource_location_that_is_no_local_file_is_refused_by_name(
     assert any("no slavemodule.txt in" in ln for ln in out), out
 
 
+@pytest.mark.slow  # in the slow suite (CI runs it): the default stays under 2 minutes
 def test_m739_train_and_verge_coupled_in_a_c_host_match_our_jacobi_master(
     host: Path, tmp_path: Path
 ) -> None:

@@ -162,6 +162,7 @@ def test_a_set_point_beyond_the_inputs_range_is_refused(controller: Path, tmp_pa
         load_scene(path)
 
 
+@pytest.mark.slow  # in the slow suite (CI runs it): the default stays under 2 minutes
 def test_crosscheck_gives_fmpy_simulate_fmu_the_same_input(controller: Path, tmp_path: Path):
     """``mechcosim crosscheck`` runs a one-FMU scene with held signals through FMPy's
     simulate_fmu with the signals as its input table, and libcosim (--via osp) with them

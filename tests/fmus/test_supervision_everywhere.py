@@ -279,6 +279,7 @@ def test_crosscheck_reports_a_crash_in_one_line(fmu: Path, tmp_path: Path, capsy
     )
 
 
+@pytest.mark.slow  # in the slow suite (CI runs it): the default stays under 2 minutes
 def test_a_tool_whose_process_crashes_is_reported() -> None:
     """ctypes.string_at(0) reads address 0: the spawned process dies of SIGSEGV."""
     import ctypes

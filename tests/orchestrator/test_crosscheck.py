@@ -33,6 +33,7 @@ def _assert_agrees(check, tools: tuple[str, ...]) -> None:
     assert check.ok
 
 
+@pytest.mark.slow  # in the slow suite (CI runs it): the default stays under 2 minutes
 def test_m739_with_its_integer_impact_connection_in_libcosim_and_fmpy() -> None:
     """Past the first impact: a train that never sees the verge's impact count would be
     off by the impact's change of speed."""
@@ -51,6 +52,7 @@ def test_two_inertias_in_libcosim_and_fmpy() -> None:
     _assert_agrees(crosscheck(SCENARIOS / "two_inertias.toml", stop=0.01), ("libcosim", "fmpy"))
 
 
+@pytest.mark.slow  # in the slow suite (CI runs it): the default stays under 2 minutes
 def test_press_feed_run1_in_libcosim_from_the_osp_file_and_in_fmpy() -> None:
     check = crosscheck(SCENARIOS / "press_feed_run1.toml", stop=0.02, via="osp")
     _assert_agrees(check, ("libcosim", "fmpy"))

@@ -141,7 +141,9 @@ def test_guard_raises_at_once_only_when_asked() -> None:
         guard.handle(signal.SIGINT, None)
 
 
-@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
+@pytest.mark.parametrize(
+    "sig", [signal.SIGINT, pytest.param(signal.SIGTERM, marks=pytest.mark.slow)]
+)
 def test_run_interrupted_at_a_random_moment(tmp_path: Path, sig: int) -> None:
     # Within the run's first 2.5 s (the whole command takes about 4 s on the 2-core
     # machine); a signal after the run has completed leaves it completed, with exit 0.

@@ -222,6 +222,7 @@ def test_sensitivity_ranks_the_input_that_matters() -> None:
 # -- studies that run --------------------------------------------------------------------
 
 
+@pytest.mark.slow  # in the slow suite (CI runs it): the default stays under 2 minutes
 def test_statistics_recover_the_closed_form_lognormal_peak_torque(tmp_path: Path) -> None:
     result = run_study(scene_file(tmp_path), workers=1, show_progress=False)
     assert [s.status for s in result.samples] == [OK] * 80

@@ -25,6 +25,7 @@ def jobs(tmp_path: Path, tag: str) -> list[Job]:
     ]
 
 
+@pytest.mark.slow  # in the slow suite (CI runs it): the default stays under 2 minutes
 def test_pool_and_dask_give_identical_results(tmp_path: Path, fmu_cache, monkeypatch) -> None:
     pytest.importorskip("dask.distributed")
     from dask.distributed import LocalCluster

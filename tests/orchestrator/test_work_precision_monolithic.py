@@ -179,6 +179,7 @@ def test_no_monolithic_model_without_a_family_model() -> None:
         assert monolithic_model(SimpleNamespace(reference=reference)) is None
 
 
+@pytest.mark.slow  # in the slow suite (CI runs it): the default stays under 2 minutes
 def test_precision_run_on_a_short_clock_train_writes_the_monolithic_columns(
     tmp_path: Path, fmu_cache, monkeypatch
 ) -> None:

@@ -69,6 +69,7 @@ def test_run2_scene_defaults_to_the_regime_aware_master():
     assert load_scene(SCENARIOS / "press_feed_run2.toml").master.algorithm == "regime-aware"
 
 
+@pytest.mark.slow  # in the slow suite (CI runs it): the default stays under 2 minutes
 def test_run1_switches_are_located(runs):
     r, ref = runs("press_feed_run1.toml")
     assert r.status == "completed", r.message
@@ -117,6 +118,7 @@ def test_run2_finds_the_grazing_disengagements(runs):
             assert max(errors) < 1e-4, (key, errors)
 
 
+@pytest.mark.slow  # in the slow suite (CI runs it): the default stays under 2 minutes
 def test_run2_feed_still_ends_in_the_thesis_regimes(runs):
     r, ref = runs("press_feed_run2.toml")
     assert r.accuracy["headline_error.feed_length_mean"] < 1e-3

@@ -59,7 +59,9 @@ def test_component_steps_are_exact_for_held_inputs() -> None:
     assert sd.stored_energy + sd.dissipated_work == pytest.approx(0.5e-4, rel=1e-12)
 
 
-@pytest.mark.parametrize("algorithm", ["jacobi", "gauss-seidel"])
+@pytest.mark.parametrize(
+    "algorithm", ["jacobi", pytest.param("gauss-seidel", marks=pytest.mark.slow)]
+)
 def test_coupling_error_is_first_order_in_the_macro_step(tmp_path, fmu_cache, algorithm) -> None:
     steps = [4e-4, 2e-4, 1e-4, 5e-5]
     errors = []
