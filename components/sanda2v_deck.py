@@ -588,14 +588,13 @@ CONTACT_RATIO_RANGE = (0.95, 1.05)
 FACE_ANGLE_TOLERANCE = 0.01 * DEG
 
 
-_BY_SYMBOL: dict[str, str] = {}
+#: SANDA2V symbol -> the parameter that carries it.
+_BY_SYMBOL = {e.symbol: e.name for e in DECK}
 
 
 def _named(symbol: str, text: str) -> str:
     """A quantity as the rules print it: its SANDA2V symbol and value, then the parameter
     that carries it (what a user sets)."""
-    if not _BY_SYMBOL:
-        _BY_SYMBOL.update({e.symbol: e.name for e in DECK})
     name = _BY_SYMBOL.get(symbol)
     return f"{text} ({name})" if name else text
 

@@ -11,13 +11,18 @@ from importlib import import_module
 from typing import Any
 
 
+def resolve(entry: str) -> Callable[..., Any]:
+    """The callable an entry "package.module:attribute" names (imports its module)."""
+    module, _, attribute = entry.partition(":")
+    return getattr(import_module(module), attribute)
+
+
 class LazyRegistry(Mapping[str, Callable[..., Any]]):
     def __init__(self, entries: dict[str, str]) -> None:
         self._entries = dict(entries)  # name -> "package.module:attribute"
 
     def __getitem__(self, name: str) -> Callable[..., Any]:
-        module, _, attribute = self._entries[name].partition(":")
-        return getattr(import_module(module), attribute)
+        return resolve(self._entries[name])
 
     def __iter__(self) -> Iterator[str]:
         return iter(self._entries)

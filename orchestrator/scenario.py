@@ -18,7 +18,7 @@ from fmus.build import BuildError, build_fmu
 from fmus.ports import PortError, PortSide, join_ports
 from fmus.registry import FMU_RECORDS
 from orchestrator.errors import ScenarioError
-from orchestrator.lazy import LazyRegistry
+from orchestrator.lazy import resolve
 from orchestrator.master_settings import (
     ALGORITHMS,
     COMMON_KEYS,
@@ -394,7 +394,7 @@ class _Loader:
                     if not isinstance(value, str):
                         raise ScenarioError(path, dotted, f"expected text, got {value!r}")
                     continue
-                if isinstance(value, dict) and not _is_value_table(value):
+                if isinstance(value, dict):
                     take(value, dotted)
                     continue
                 if name in out:
@@ -414,7 +414,7 @@ class _Loader:
         check = family(scene.family).design_check
         if check is None:
             return
-        problems = LazyRegistry({"check": check})["check"](scene)
+        problems = resolve(check)(scene)
         if problems:
             more = f" (and {len(problems) - 1} more)" if len(problems) > 1 else ""
             raise self.fail("parameters", f"{problems[0]}{more}")
@@ -1001,11 +1001,6 @@ def _designs(component: str | None, name: str) -> bool:
     if component is None or component not in FMU_RECORDS:
         return False
     return any(v.name == name and v.design for v in FMU_RECORDS[component].variables)
-
-
-def _is_value_table(node: dict[str, Any]) -> bool:
-    """A table that is one value (a signal, a distribution), not a group of quantities."""
-    return any(k in node for k in ("table", "csv", "step", "ramp", "value", "unit"))
 
 
 def _takes(component: str | None, model: ModelInfo, shared: SharedParameter | None) -> bool:

@@ -119,14 +119,6 @@ def retime(curve: MonolithicCurve, model: Callable[[float], Any]) -> MonolithicC
     return MonolithicCurve(curve.truth, curve.truth_wall_time, points)
 
 
-def _parameter(scene: Scene, instance: str, name: str) -> float:
-    """A parameter of an instance as the scene sets it, else its FMU's start value."""
-    spec = scene.fmus[instance]
-    if name in spec.parameters:
-        return spec.parameters[name]
-    return scene.component_class(instance).variable(name).start
-
-
 def _m739(scene: Scene) -> Callable[[float], Any]:
     # The same arguments as the family's reference (orchestrator/scenes/m739/report.py).
     from orchestrator.scenes.m739.monolithic import run_m739
@@ -138,20 +130,10 @@ def _m739(scene: Scene) -> Callable[[float], Any]:
 
 def _clock_train(scene: Scene) -> Callable[[float], Any]:
     # The same arguments as the family's reference (orchestrator/scenes/clock_train/report.py).
-    from orchestrator.scenes.clock_train.monolithic import ARMING_ROTOR_ANGLE, run_clock_train
-    from orchestrator.scenes.m739.report import escapement_arguments, instance_names
+    from orchestrator.scenes.clock_train.monolithic import run_clock_train
+    from orchestrator.scenes.clock_train.report import monolithic_arguments
 
-    train, verge = instance_names(scene)
-    arming = scene.stop_when.threshold if scene.stop_when else ARMING_ROTOR_ANGLE
-    kwargs = {
-        **escapement_arguments(scene, train, verge),
-        "loss_model": int(_parameter(scene, train, "loss_model")),
-        "pivot_loads": _parameter(scene, train, "pivot_loads") == 1.0,
-        "mesh_phase": _parameter(scene, train, "mesh_phase"),
-        "center_distance": _parameter(scene, verge, "center_distance"),
-        "pallet_inertia": _parameter(scene, verge, "pallet_inertia"),
-        "rotor_arming_angle": arming,
-    }
+    kwargs = monolithic_arguments(scene)
     return lambda tolerance: run_clock_train(tolerance=tolerance, **kwargs)
 
 

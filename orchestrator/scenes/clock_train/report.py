@@ -84,25 +84,32 @@ def analyse(
     return out
 
 
-def reference(scene: Scene) -> Reference:
-    """The monolithic clock-train S&A with the scene's physics, as the yardstick."""
+def monolithic_arguments(scene: Scene) -> dict[str, Any]:
+    """What ``run_clock_train`` takes for the scene: its operating point, its design and
+    its arming angle (the reference and the work-precision curve both run it so)."""
     train, verge = instance_names(scene)
     signal, level, _ = _arming(scene, train)
     if signal != f"{train}.rotor_angle":
         raise ValueError(
             f"clock_train reference: arming must be scene.stop_when on {train}.rotor_angle"
         )
-    result = run_clock_train(
+    return {
         **escapement_arguments(scene, train, verge),
-        loss_model=int(_parameter(scene, train, "loss_model")),
-        pivot_loads=_parameter(scene, train, "pivot_loads") == 1.0,
-        mesh_phase=_parameter(scene, train, "mesh_phase"),
-        center_distance=_parameter(scene, verge, "center_distance"),
-        pallet_inertia=_parameter(scene, verge, "pallet_inertia"),
-        rotor_arming_angle=level,
-        design=train_values(scene),
-        verge_data=verge_data(scene),
-    )
+        "loss_model": int(_parameter(scene, train, "loss_model")),
+        "pivot_loads": _parameter(scene, train, "pivot_loads") == 1.0,
+        "mesh_phase": _parameter(scene, train, "mesh_phase"),
+        "center_distance": _parameter(scene, verge, "center_distance"),
+        "pallet_inertia": _parameter(scene, verge, "pallet_inertia"),
+        "rotor_arming_angle": level,
+        "design": train_values(scene),
+        "verge_data": verge_data(scene),
+    }
+
+
+def reference(scene: Scene) -> Reference:
+    """The monolithic clock-train S&A with the scene's physics, as the yardstick."""
+    train, verge = instance_names(scene)
+    result = run_clock_train(**monolithic_arguments(scene))
     ref = reference_from(result, train, verge)
     if result.armed:
         ref.headline["phi_at_arming"] = result.phi_end
