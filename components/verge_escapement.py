@@ -687,8 +687,9 @@ class VergeCore:
             face = "entrance" if self.face == ENTRANCE else "exit"
             self.fault = (
                 f"the escapement skips teeth: at t = {self.t_base + t:.6g} s a tooth passed "
-                f"the {face} face in free flight without touching it (a design that "
-                "does not escape; mechcosim check names the rule)"
+                f"the {face} face in free flight without touching it: a design that does "
+                "not escape (mechcosim check names the rule), or an integration that stepped "
+                "over the contact (a tighter tolerance tells which)"
             )
             self.halted = True
             return y
