@@ -30,6 +30,36 @@ from dataclasses import dataclass, field, replace
 from typing import Any, ClassVar, Literal
 
 Causality = Literal["parameter", "input", "output"]
+#: What a master may rely on a variable for beyond its causality, where FMI 2.0 has no word
+#: for it (the model description carries it in our vendor annotation, fmus/description.py):
+#: rate_of X (a Real input: X's rate over a step, ramped about its held value at mid-step),
+#: step_mean_of X (an output: X's mean over the last step), own_copy_of X (an output: the
+#: component's own copy of its sampled input X at the step end), early_return (the Integer
+#: input asking a step to end at its first event), reached_time (the output saying where
+#: the last step ended).
+RoleKind = Literal["rate_of", "step_mean_of", "own_copy_of", "early_return", "reached_time"]
+#: The role kinds that name another variable (``Role.of``).
+ROLES_OF = ("rate_of", "step_mean_of", "own_copy_of")
+#: Of each role kind: the causality of the variable that carries it, and of the one it names.
+ROLE_CAUSALITY: dict[str, tuple[str, str | None]] = {
+    "rate_of": ("input", "input"),
+    "step_mean_of": ("output", "output"),
+    "own_copy_of": ("output", "input"),
+    "early_return": ("input", None),
+    "reached_time": ("output", None),
+}
+
+
+@dataclass(frozen=True)
+class Role:
+    """A variable's coupling role: its kind and, for rate_of, step_mean_of and
+    own_copy_of, the variable it refers to."""
+
+    kind: RoleKind
+    of: str | None = None
+
+    def __str__(self) -> str:
+        return f"{self.kind} {self.of}" if self.of else self.kind
 
 
 @dataclass(frozen=True)
@@ -63,6 +93,25 @@ class Variable:
     #: (its description ends with the source symbol, "[SANDA2V: CAPRB1]").  A scene states
     #: it once, in its design, and every FMU of the scene that declares it takes that value.
     design: bool = False
+    #: Its coupling role (see ``Role``); None: a plain variable.
+    role: Role | None = None
+
+
+def role_problem(var: Variable, by_name: dict[str, Variable]) -> str | None:
+    """What is wrong with a variable's role among the variables ``by_name``, said in one
+    line; None if nothing is (or it has none)."""
+    role = var.role
+    if role is None:
+        return None
+    own, other = ROLE_CAUSALITY[role.kind]
+    if var.causality != own:
+        return f"{var.name} has the role {role} but is an {var.causality}; expected an {own}"
+    if other is None:
+        return None
+    target = by_name.get(role.of or "")
+    if target is None or target.causality != other:
+        return f"{var.name} has the role {role}, but {role.of!r} is not an {other} of it"
+    return None
 
 
 def design_parameter(
@@ -269,4 +318,5 @@ def rate_input(name: str, unit: str) -> Variable:
         f"{unit}/s",
         0.0,
         f"rate of {name} over a step: it ramps about its held value at mid-step",
+        role=Role("rate_of", name),
     )

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from .base import Variable
+from .base import Role, Variable
 
 EARLY_RETURN_VARIABLES = (
     Variable(
@@ -24,8 +24,16 @@ EARLY_RETURN_VARIABLES = (
         "1: end a step at its first event after the step start (see t_reached)",
         "Integer",
         sampled=True,
+        role=Role("early_return"),
     ),
-    Variable("t_reached", "output", "s", 0.0, "where the last step ended (early return)"),
+    Variable(
+        "t_reached",
+        "output",
+        "s",
+        0.0,
+        "where the last step ended (early return)",
+        role=Role("reached_time"),
+    ),
 )
 
 

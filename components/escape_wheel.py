@@ -10,7 +10,7 @@ first moment, not a held torque.
 
 from __future__ import annotations
 
-from .base import Variable
+from .base import Role, Variable
 from .early_return import EARLY_RETURN_VARIABLES
 
 #: The escape-wheel port of a spin-driven train, and of the verge on the other side: the
@@ -131,6 +131,7 @@ ESCAPE_WHEEL_VARIABLES = (
         "N.m/s",
         0.0,
         "the load's rate over the step, about its mean at the step's middle (0: held)",
+        role=Role("rate_of", "T_esc"),
     ),
     Variable(
         "impact_count",

@@ -54,7 +54,7 @@ import math
 from collections.abc import Callable
 from typing import Any
 
-from .base import Component, ComponentError, SnapshotPlan, Variable, common_outputs
+from .base import Component, ComponentError, Role, SnapshotPlan, Variable, common_outputs
 from .design_rules import raise_first
 from .early_return import EARLY_RETURN_VARIABLES, UntilFirstEvent, reached
 from .escape_wheel import ESCAPE_WHEEL_PORT
@@ -964,13 +964,41 @@ class VergeEscapement(Component):
         # Over the last step, for a train stepped after the verge over the same interval:
         # the escapement as the plain torque whose impulse the verge's wheel took (impacts
         # aside: they reach the train as phi_dot_post), exact with early return.
-        Variable("T_esc_mean", "output", "N.m", 0.0, "T_esc over the last step, mean"),
-        Variable("T_esc_static_mean", "output", "N.m", 0.0, "= T_esc_mean (with J_esc_mean = 0)"),
-        Variable("J_esc_mean", "output", "kg.m2", 0.0, "0: the step mean is a plain torque"),
+        Variable(
+            "T_esc_mean",
+            "output",
+            "N.m",
+            0.0,
+            "T_esc over the last step, mean",
+            role=Role("step_mean_of", "T_esc"),
+        ),
+        Variable(
+            "T_esc_static_mean",
+            "output",
+            "N.m",
+            0.0,
+            "= T_esc_mean (with J_esc_mean = 0)",
+            role=Role("step_mean_of", "T_esc_static"),
+        ),
+        Variable(
+            "J_esc_mean",
+            "output",
+            "kg.m2",
+            0.0,
+            "0: the step mean is a plain torque",
+            role=Role("step_mean_of", "J_esc"),
+        ),
         # And its rate about the mean at the step's middle, from the torque's first moment:
         # 0 as a held signal, the step's as its mean.
         Variable("T_esc_rate", "output", "N.m/s", 0.0, "0: T_esc is held over a step"),
-        Variable("T_esc_rate_mean", "output", "N.m/s", 0.0, "T_esc's rate over the last step"),
+        Variable(
+            "T_esc_rate_mean",
+            "output",
+            "N.m/s",
+            0.0,
+            "T_esc's rate over the last step",
+            role=Role("step_mean_of", "T_esc_rate"),
+        ),
         Variable(
             "phi_ddot",
             "output",
@@ -985,6 +1013,7 @@ class VergeEscapement(Component):
             "rad",
             0.0,
             "escape-wheel angle (own copy)",
+            role=Role("own_copy_of", "phi"),
             depends_on=("phi",),
         ),
         Variable(
@@ -993,6 +1022,7 @@ class VergeEscapement(Component):
             "rad/s",
             0.0,
             "escape-wheel speed (own copy)",
+            role=Role("own_copy_of", "phi_dot"),
             depends_on=("phi_dot",),
         ),
         Variable(

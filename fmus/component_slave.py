@@ -47,7 +47,7 @@ from pythonfmu.default_experiment import DefaultExperiment
 from pythonfmu.enums import Fmi2Status
 
 if TYPE_CHECKING:
-    from components.base import Component
+    from components.base import Component, Variable
 
 
 class FmiCallError(ValueError):
@@ -116,6 +116,11 @@ class ComponentSlave(Fmi2Slave):
         self._start_time = 0.0
         self._t_end = 0.0  # where the last step ended: the next one starts there
         self._last_h = 0.0
+        # the output by which a component that ends its step at its first event says where
+        # (components.early_return), found by its role
+        self._reached = next(
+            (v.name for v in self.component_class.VARIABLES if _kind(v) == "reached_time"), None
+        )
         for var in self.component_class.VARIABLES:
             self._register(var)
         reals = {vr for vr, kind in enumerate(self._types) if kind == "Real"}
@@ -270,8 +275,8 @@ class ComponentSlave(Fmi2Slave):
                 Fmi2Status.error,
             )
             return False
-        # a component that ends its step at its first event says where (components.early_return)
-        self._t_end = float(getattr(self.model, "t_reached", current_time + step_size))
+        reached = self._reached
+        self._t_end = float(getattr(self.model, reached) if reached else current_time + step_size)
         self._last_h = step_size
         return True
 
@@ -393,6 +398,12 @@ class ComponentSlave(Fmi2Slave):
 #: A step starts where the last ended, up to this relative difference (a host that computes
 #: t_k = k h rather than summing the steps).
 TIME_MATCH = 1e-9
+
+
+def _kind(var: Variable) -> str | None:
+    """The kind of a variable's coupling role (components.base.Role), None if it has none."""
+    role = getattr(var, "role", None)
+    return role.kind if role is not None else None
 
 
 def _component_class(path: str) -> type[Component]:

@@ -9,22 +9,24 @@ the name.  ``complete_description`` adds, from the component's VARIABLES table:
 * an honest ModelStructure: each output lists the inputs it depends on directly
   (``dependencies=""`` where it depends on none), so that other masters see no false
   algebraic loops;
-* a vendor annotation (tool ``mechcosim``) with what a master needs beyond plain FMI:
-  ports as groups of variables by role, the sampled inputs, the event indicators, the
-  output that reports the time of an internal event, and the regime output.  Any master
-  may ignore it; ours read it (``orchestrator/model_info.py``).
+* a vendor annotation (tool ``mechcosim``) with what a master needs and FMI 2.0 cannot
+  say: ports as groups of variables by role, the sampled inputs, the event indicators, the
+  output that reports the time of an internal event, the regime output, and each
+  variable's coupling role (``components.base.Role``: rate of, step mean of, own copy of,
+  early return, reached time).  Any master may ignore it; ours read it
+  (``orchestrator/model_info.py``).
 """
 
 from __future__ import annotations
 
 from xml.etree import ElementTree as ET
 
-from components.base import Component, Variable
+from components.base import Component, Variable, role_problem
 from fmus.units import base_unit_exponents
 
 #: The vendor annotation's tool name, and the version of its layout.
 TOOL = "mechcosim"
-ANNOTATION_VERSION = "1"
+ANNOTATION_VERSION = "2"  # 2: with Roles
 #: Outputs named so are event indicators: a regime switch happens where one crosses zero.
 INDICATOR_PREFIX = "ind_"
 EVENT_TIME = "t_event"
@@ -119,6 +121,16 @@ def _vendor_annotation(component_class: type[Component]) -> ET.Element:
         ET.SubElement(ours, "EventTime", variable=EVENT_TIME)
     if REGIME in names:
         ET.SubElement(ours, "Regime", variable=REGIME)
+    roles = ET.SubElement(ours, "Roles")
+    by_name = {v.name: v for v in component_class.VARIABLES}
+    for var in component_class.VARIABLES:
+        if var.role is None:
+            continue
+        problem = role_problem(var, by_name)
+        if problem is not None:
+            raise ValueError(f"{component_class.__name__}: {problem}")
+        of = {"of": var.role.of} if var.role.of else {}
+        ET.SubElement(roles, "Variable", name=var.name, role=var.role.kind, **of)
     return annotations
 
 

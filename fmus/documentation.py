@@ -214,6 +214,8 @@ def _variables_section(cls: type[Component]) -> str:
         if var.causality == "output":
             deps = ", ".join(f"<code>{escape(d)}</code>" for d in var.depends_on) or "none"
             notes.append(f"direct feedthrough from: {deps}")
+        if var.role is not None:  # carried in the vendor annotation (fmus/description.py)
+            notes.append(f"coupling role: <code>{escape(str(var.role))}</code>")
         vtype = "Enumeration" if var.name == REGIME and names else var.type
         rows.append(
             f'<tr class="variable" id="var-{escape(var.name)}">'

@@ -4,8 +4,10 @@ Plain FMI 2.0 gives the variables (causality, type, unit, start, range), the uni
 definitions, the output dependencies and the capabilities.  Our own FMUs declare more in
 a vendor annotation (``fmus/description.py``): ports as groups of variables by role, the
 sampled inputs, the event indicators, the output that reports an internal event's time,
-and the regime output, whose names come from its Enumeration type.  An FMU from another
-tool has none of these and is a black box: no ports, no indicators, every input held.
+the regime output, whose names come from its Enumeration type, and each variable's
+coupling role (``components.base.Role``), which masters read through ``role_of`` and
+``with_role`` (never from names).  An FMU from another tool has none of these and is a
+black box: no ports, no indicators, no roles, every input held.
 """
 
 from __future__ import annotations
@@ -20,6 +22,7 @@ from xml.etree import ElementTree as ET
 
 from fmpy import read_model_description
 
+from components.base import ROLE_CAUSALITY, ROLES_OF, Role
 from fmus.description import TOOL
 from orchestrator.units import pint_unit
 
@@ -72,6 +75,23 @@ class ModelInfo:
     regime: str | None = None
     regime_names: dict[int, str] = field(default_factory=dict)
     annotated: bool = False  # carries our vendor annotation
+    #: variable name -> its coupling role (our vendor annotation only)
+    roles: dict[str, Role] = field(default_factory=dict)
+    #: FMI 2.0 capabilities beyond the two above (the standard's defaults where not declared)
+    can_interpolate_inputs: bool = False
+    max_output_derivative_order: int = 0
+
+    def role_of(self, name: str) -> Role | None:
+        """The coupling role of variable ``name``; None where it has none."""
+        return self.roles.get(name)
+
+    def with_role(self, kind: str, of: str | None = None) -> VariableInfo | None:
+        """The variable with the role ``kind`` (of variable ``of``, for the kinds that name
+        one); None where the FMU declares none."""
+        for name, role in self.roles.items():
+            if role.kind == kind and role.of == of:
+                return self.variables[name]
+        return None
 
     def of(self, causality: str) -> list[VariableInfo]:
         return [v for v in self.variables.values() if v.causality == causality]
@@ -138,6 +158,8 @@ def model_info(path: Path) -> ModelInfo:
         variables=variables,
         can_get_set_state=bool(md.coSimulation.canGetAndSetFMUstate),
         can_handle_variable_step=bool(md.coSimulation.canHandleVariableCommunicationStepSize),
+        can_interpolate_inputs=bool(md.coSimulation.canInterpolateInputs),
+        max_output_derivative_order=int(md.coSimulation.maxOutputDerivativeOrder or 0),
         dependencies=dependencies,
         unit_definitions=units,
     )
@@ -240,6 +262,7 @@ def _coupling(node: ET.Element, variables: dict[str, VariableInfo], md: Any) -> 
         if declared is not None:
             regime_names = {int(item.value): item.name for item in declared.items}
     return dict(
+        roles=_roles(node, variables, md.modelName),
         ports=ports,
         sampled=frozenset(names("SampledInputs")),
         indicators=tuple(names("EventIndicators")),
@@ -248,3 +271,23 @@ def _coupling(node: ET.Element, variables: dict[str, VariableInfo], md: Any) -> 
         regime_names=regime_names,
         annotated=True,
     )
+
+
+def _roles(node: ET.Element, variables: dict[str, VariableInfo], model: str) -> dict[str, Role]:
+    """The annotation's coupling roles, each checked against the variables it names."""
+    roles: dict[str, Role] = {}
+    for element in node.iterfind("Roles/Variable"):
+        name, kind, of = element.get("name"), element.get("role"), element.get("of")
+        where = f"{model}: the annotation's role of {name!r}"
+        if kind not in ROLE_CAUSALITY:
+            raise ModelInfoError(f"{where} is {kind!r}; expected one of {sorted(ROLE_CAUSALITY)}")
+        own, other = ROLE_CAUSALITY[kind]
+        var = variables.get(name)
+        if var is None or var.causality != own:
+            raise ModelInfoError(f"{where}, {kind}: expected an {own} of that name")
+        if (of is not None) != (kind in ROLES_OF):
+            raise ModelInfoError(f"{where}, {kind}: 'of' is {'missing' if of is None else 'extra'}")
+        if other is not None and (of not in variables or variables[of].causality != other):
+            raise ModelInfoError(f"{where}, {kind} {of}: expected {of!r} to be an {other}")
+        roles[name] = Role(kind, of)
+    return roles

@@ -1,12 +1,9 @@
-"""Copies of a sampled input that a receiver reports (an output named after the input with
-``_own``: the verge's copy of the escape wheel), and how the single pass judges them."""
+"""Copies of a sampled input that a receiver reports (an output with the role own_copy_of
+the input: the verge's copy of the escape wheel), and how the single pass judges them."""
 
 from __future__ import annotations
 
 from typing import Any
-
-#: Suffix of the output by which an FMU reports its own copy of a sampled input.
-OWN_SUFFIX = "_own"
 
 Slot = tuple[int, int]  # (instance, index of a Real output)
 Copy = tuple[Slot, Slot]  # (source slot, receiver's copy slot)
@@ -42,16 +39,18 @@ def angles_with_speeds(
     ]
 
 
-def copied_inputs(system: Any) -> list[tuple[Slot, int, str]]:
+def copied_inputs(system: Any) -> list[tuple[Slot, int, str, str]]:
     """The sampled Real inputs whose receiver reports its own copy at the step end (an
-    output named after the input with ``_own``): (source slot, receiver, input name)."""
+    output with the role own_copy_of the input): (source slot, receiver, input name, name
+    of the copy)."""
     found = []
     for c, src in zip(system.connections, system.connection_sources, strict=True):
         j = system.index[c.target[0]]
         model = system.models[j]
         if src is not None and c.target[1] in model.sampled:
-            if c.target[1] + OWN_SUFFIX in model.variables:
-                found.append((src, j, c.target[1]))
+            own = model.with_role("own_copy_of", c.target[1])
+            if own is not None:
+                found.append((src, j, c.target[1], own.name))
     return found
 
 

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 
+from orchestrator.capabilities import check_fixed_step
 from orchestrator.master_settings import FixedStepSettings
 from orchestrator.masters.macro_step import MacroStep
 from orchestrator.recorder import StepStats
@@ -34,6 +35,7 @@ class FixedStepMaster:
         stats: StepStats,
         sequential: bool,
     ) -> None:
+        check_fixed_step(system, start, stop, h)
         self.system, self.h, self.stats, self.sequential = system, h, stats, sequential
         self.start, self.stop = start, stop
         self.n = _grid(start, stop, h)

@@ -13,8 +13,8 @@ flies free) is not stepped again: it is restored to its state just after the pre
 step.  Black-box inputs stay at their step-start values (masters/held_inputs.py), and
 their change counts where it is the larger error.
 
-Where an FMU takes a held input's rate over the step (a Real input named after it with
-``_rate``, neither connected nor driven: the press feed's drive and brake take the clutch
+Where an FMU takes a held input's rate over the step (a Real input with the role rate_of
+it, neither connected nor driven: the press feed's drive and brake take the clutch
 torque's), the corrector also sets that rate, the slope from the start to the predicted
 end value, so the input ramps through the step (first-order hold) rather than sitting at
 its mean: the receiver then takes the first moment of its change too.
@@ -36,9 +36,6 @@ from orchestrator.masters.regime_aware import Estimate, RestartSteps, Trial
 from orchestrator.masters.switches import Landing, StepStart, Switch, back_to_start, switch_time
 from orchestrator.recorder import StepStats
 from orchestrator.system import CoupledSystem
-
-#: Suffix of the Real input by which an FMU takes a held input's rate over a step.
-RATE_SUFFIX = "_rate"
 
 
 @dataclass(frozen=True)
@@ -300,11 +297,11 @@ class MidpointTrials:
         return ramps
 
     def _rate_input(self, j: int, name: str) -> Any:
-        """A setter of instance j's ``<name>_rate`` input, None where it takes no rate (no
-        such Real input, or one a connection or a scene signal drives)."""
+        """A setter of instance j's input with the role rate_of ``name``, None where it takes
+        no rate (no such Real input, or one a connection or a scene signal drives)."""
         system = self.system
-        rate = system.models[j].variables.get(name + RATE_SUFFIX)
-        if rate is None or rate.causality != "input" or rate.is_integer:
+        rate = system.models[j].with_role("rate_of", name)
+        if rate is None or rate.is_integer:
             return None
         target = (system.names[j], rate.name)
         if target in system.signals.driven or any(

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from dataclasses import replace
 
+from orchestrator import capabilities
 from orchestrator.masters.copies import judged_by_copies
 from orchestrator.masters.fixed_step import fixed_step_master
 from orchestrator.masters.macro_step import Master
@@ -23,22 +24,17 @@ from orchestrator.system import CoupledSystem
 
 def regime_aware(system: CoupledSystem, scene: Scene, stats: StepStats) -> Master:
     """The regime-aware master of ``scene``; fixed-step Jacobi where an FMU cannot save and
-    restore its state."""
-    cannot_save = [
-        n for n, m in zip(system.names, system.models, strict=True) if not m.can_get_set_state
-    ]
+    restore its state or take steps of varying size (orchestrator/capabilities.py)."""
+    shortfalls = capabilities.regime_aware_shortfalls(system)
     fixed = (
         f"fixed-step Jacobi in steps of {scene.master.step:g} s (no error control, switches "
         "seen only at communication points)"
     )
-    if cannot_save:
-        # Without rollback no trial can be taken back: say what is given up, and couple
-        # the way every tool can.
-        stats.extra.setdefault("warnings", []).append(
-            f"FMU {', '.join(map(repr, cannot_save))} cannot save and restore its state "
-            "(canGetAndSetFMUstate is false), which the regime-aware master needs to reject "
-            f"steps and to land on switches: it gives both up and runs {fixed}"
-        )
+    if shortfalls:
+        # Without rollback and varying steps no trial can be taken back: say what is given
+        # up, and couple the way every tool can.
+        warning = capabilities.regime_aware_fallback(shortfalls, fixed)
+        stats.extra.setdefault("warnings", []).append(warning)
         return fixed_step_master(system, scene, stats, scene.master.step, sequential=False)
     # A restore that does not reproduce a step would make every rollback change the
     # answer: such an FMU is not rolled back, and no FMU is, as no trial could be retaken.

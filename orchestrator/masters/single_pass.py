@@ -7,7 +7,7 @@ Inputs.  A held input is set to the mean over the step of its source's linear
 extrapolation from the last exchange point of the same regime (after a regime switch the
 first step holds the start values; over an FMU's internal event the slopes go on:
 masters/input_extrapolation.py).  A source stepped earlier in the same pass that gives its
-step mean (an output named after the connected one with ``_mean``: the verge's escapement
+step mean (an output with the role step_mean_of the connected one: the verge's escapement
 torque whose impulse its wheel took) gives that instead, so its receiver takes the very
 impulse of the step; so does its rate over the step (``T_esc_rate_mean``, from the
 torque's first moment), so the train ramps its load and takes the impulse's first moment
@@ -17,7 +17,8 @@ follows the train over the step rather than held values: the copy's mismatch the
 far that M739's macro steps are bounded by its switches, not by the tolerance (no longest
 step but the run unless the scene sets one: ``RegimeAwareSettings.longest_step``).
 
-Error.  Where a receiver reports its own copy of a sampled input (masters/copies.py: the
+Error.  Where a receiver reports its own copy of a sampled input (an output with the role
+own_copy_of it, masters/copies.py: the
 verge's copy of the escape wheel), the estimate is the copy's mismatch with the source at
 the step end against the source's travel in the step: it measures the held inputs' effect
 on the motion, and the mismatches of all steps add up to at most the tolerance times the
@@ -30,8 +31,8 @@ trapezoidal mean of its actual start and end values, relative to its running sca
 Schierz, Arnold & Clauß, "Co-simulation with communication step size control in an FMI
 compatible master algorithm", 9th International Modelica Conference (2012).
 
-Switches.  An FMU with an Integer input ``early_return`` (``components.early_return``)
-ends its step at its first event and says where in ``t_reached``; such FMUs are stepped
+Switches.  An FMU with an input of the role early_return (``components.early_return``)
+ends its step at its first event and says where in its reached_time output; such FMUs are stepped
 first (those giving step means before their receivers), each to where the earliest so far
 stopped, and the others once to that instant: landing on a switch costs one doStep of
 each FMU, none retaken.  When one stops before an instant the ones before it were stepped
@@ -45,20 +46,13 @@ from __future__ import annotations
 from typing import NamedTuple
 
 from orchestrator.master_settings import RegimeAwareSettings
-from orchestrator.masters.copies import OWN_SUFFIX, Copy, angles_with_speeds, copied_inputs
+from orchestrator.masters.copies import Copy, angles_with_speeds, copied_inputs
 from orchestrator.masters.held_inputs import HeldInputs
 from orchestrator.masters.input_extrapolation import InputExtrapolation
 from orchestrator.masters.regime_aware import Estimate, RestartSteps, Trial
 from orchestrator.masters.switches import Landing, Readings, StepStart, Switch, switch_time
 from orchestrator.recorder import StepStats
 from orchestrator.system import CoupledSystem
-
-#: Name of the Integer input by which an FMU offers to end a step at its first event, and
-#: of the output that says where it stopped.
-EARLY_RETURN_INPUT = "early_return"
-REACHED_OUTPUT = "t_reached"
-#: Suffix of the output that is the mean of another over the last step.
-MEAN_SUFFIX = "_mean"
 
 
 class _Pass(NamedTuple):
@@ -96,22 +90,22 @@ class SinglePassTrials:
         self.early: list[int] = []
         self.reached_slot: dict[int, int] = {}
         for i, (inst, model) in enumerate(zip(system.instances, system.models, strict=True)):
-            var = model.variables.get(EARLY_RETURN_INPUT)
-            out = model.variables.get(REACHED_OUTPUT)
-            if var is None or out is None or var.causality != "input":
+            var = model.with_role("early_return")
+            out = model.with_role("reached_time")
+            if var is None or out is None:
                 continue
-            if any(c.target == (system.names[i], EARLY_RETURN_INPUT) for c in system.connections):
+            if any(c.target == (system.names[i], var.name) for c in system.connections):
                 continue  # the scene drives it
-            inst.setter(inst.refs([EARLY_RETURN_INPUT]), integer=True)([1])
+            inst.setter(inst.refs([var.name]), integer=True)([1])
             self.early.append(i)
-            self.reached_slot[i] = system.real_output_slot(i, REACHED_OUTPUT)
-        # Step means: an output named after a connected one with "_mean" is its mean over
+            self.reached_slot[i] = system.real_output_slot(i, out.name)
+        # Step means: an output with the role step_mean_of a connected one is its mean over
         # the last step, what a receiver stepped after it should hold.
         self.means: dict[tuple[int, int], int] = {}
         for c, src in zip(system.connections, system.connection_sources, strict=True):
-            mean = c.source[1] + MEAN_SUFFIX
-            if src is not None and mean in system.models[src[0]].variables:
-                self.means[src] = system.real_output_slot(src[0], mean)
+            mean = system.models[src[0]].with_role("step_mean_of", c.source[1]) if src else None
+            if mean is not None:
+                self.means[src] = system.real_output_slot(src[0], mean.name)
         givers = {s for s, _ in self.means}
         self.early.sort(key=lambda i: i not in givers)
         self.late = [i for i in range(len(system.names)) if i not in self.early]
@@ -120,10 +114,10 @@ class SinglePassTrials:
         # end is the coupling error the next step start discards.
         copied = copied_inputs(system)
         copies: list[Copy] = [
-            (src, (j, system.real_output_slot(j, name + OWN_SUFFIX))) for src, j, name in copied
+            (src, (j, system.real_output_slot(j, own))) for src, j, _, own in copied
         ]
         units = [
-            system.models[j].base_unit(system.models[j].variables[n].unit) for _, j, n in copied
+            system.models[j].base_unit(system.models[j].variables[n].unit) for _, j, n, _ in copied
         ]
         self.judged = angles_with_speeds(copies, units)
         # The held inputs of FMUs joined by such a copy are judged by it (their effect on

@@ -157,6 +157,59 @@ def test_regime_aware_master_says_what_it_gives_up_without_state(tmp_path, forei
     assert_matches_reference(r)
 
 
+def fixed_step_only(fmu: Path, target: Path) -> Path:
+    """A copy of ``fmu`` whose description says it cannot take steps of varying size."""
+    with zipfile.ZipFile(fmu) as z:
+        members = {n: z.read(n) for n in z.namelist()}
+    xml = members["modelDescription.xml"].decode()
+    flag = 'canHandleVariableCommunicationStepSize="true"'
+    assert flag in xml
+    members["modelDescription.xml"] = xml.replace(flag, flag.replace("true", "false")).encode()
+    with zipfile.ZipFile(target, "w") as z:
+        for name, data in members.items():
+            z.writestr(name, data)
+    return target
+
+
+@needs_cc
+def test_foreign_fmu_without_annotation_runs_under_the_plain_masters(tmp_path, foreign) -> None:
+    info = model_info(foreign / "TorsionBody.fmu")
+    assert not info.annotated and info.roles == {}
+    for algorithm in ("jacobi", "gauss-seidel"):
+        path = write_scene(tmp_path, foreign_scene(str(foreign / "TorsionBody.fmu"), algorithm))
+        r = run_scene(load_scene(path), output_dir=tmp_path / algorithm, show_progress=False)
+        assert r.status == "completed", r.message
+        exact = two_inertias_exact(np.array([0.2]), 2e-4, 1e-4, 2.0, 2e-3, 0.0, 10.0, 0.0, 0.0)
+        # first order in the 1 ms step: Jacobi is 0.6 % off the closed form at 0.2 s
+        assert r.signal("a.phi")[-1] == pytest.approx(exact["phi_a"][-1], rel=1e-2), algorithm
+
+
+@needs_cc
+def test_an_fmu_without_variable_steps_is_refused_where_a_master_varies_its_step(
+    tmp_path, foreign
+) -> None:
+    fmu = fixed_step_only(foreign / "TorsionBody.fmu", tmp_path / "TorsionBody.fmu")
+    # The regime-aware master sizes every step: it falls back to fixed-step Jacobi, on a grid.
+    path = write_scene(tmp_path, foreign_scene(str(fmu), "regime-aware"))
+    r = run_scene(load_scene(path), output_dir=tmp_path / "aware", show_progress=False)
+    (warning,) = r.stats.extra["warnings"]
+    assert warning.startswith(
+        "FMU 'c' cannot take communication steps of varying size "
+        "(canHandleVariableCommunicationStepSize is false), which the regime-aware master needs"
+    )
+    assert "fixed-step Jacobi in steps of 0.001 s" in warning
+    assert_matches_reference(r)
+    # A fixed step of 3 ms does not divide the 0.2 s span: its last step would be shorter.
+    path = write_scene(tmp_path, foreign_scene(str(fmu), "jacobi", "3 ms"))
+    r = run_scene(load_scene(path), output_dir=tmp_path / "jacobi", show_progress=False)
+    assert r.status == "failed"
+    assert r.message == (
+        "FMU 'c': cannot take communication steps of varying size "
+        "(canHandleVariableCommunicationStepSize is false), which the fixed-step master needs "
+        "with a step of 0.003 s that does not divide the span 0.2 s"
+    )
+
+
 @needs_cc
 def test_foreign_connection_units_are_checked(tmp_path, foreign) -> None:
     text = foreign_scene(str(foreign / "TorsionBody.fmu")).replace(
