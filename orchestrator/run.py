@@ -91,7 +91,8 @@ def run_scene(
     """
     out = Path(output_dir) if output_dir else scene.output_dir
     options = _Options(compare_reference, plots, cache_dir, reference_cache, Phases())
-    with catching_signals() as guard, OutputLock(out):
+    about = {"scene": scene.name, "scene_file": str(scene.path), "stop": scene.stop}
+    with catching_signals() as guard, OutputLock(out, about):
         announce_run(scene, out)  # for a supervisor, should this process crash
         return _run_locked(scene, out, cache_dir, show_progress, options, guard)
 

@@ -27,6 +27,7 @@ from pathlib import Path
 from typing import Any
 
 from orchestrator.errors import ScenarioError
+from orchestrator.regular_files import CSV_LIMIT, NotARegularFile, read_regular
 from orchestrator.units import UREG, pint_unit
 
 INTERPOLATIONS = ("linear", "hold")
@@ -378,9 +379,11 @@ def _csv(reader: Reader, raw: dict[str, Any], key: str, var: Any):
     path = (reader.scene_path.parent / text).resolve()
     fkey = f"{key}.file"
     try:
-        data = path.read_bytes()
+        data = read_regular(path, CSV_LIMIT)
     except FileNotFoundError:
         raise reader.fail(fkey, f"no CSV file at {path}") from None
+    except NotARegularFile as exc:
+        raise reader.fail(fkey, f"{path} {exc.strerror}") from None
     except OSError as exc:
         raise reader.fail(fkey, f"cannot read {path}: {exc.strerror or exc}") from None
     try:
