@@ -443,10 +443,14 @@ def _export(args: argparse.Namespace) -> int:
     if args.osp is not None and args.osp.exists() and not args.osp.is_dir():
         print(f"error: --osp {args.osp}: is a file; expected a directory", file=sys.stderr)
         return 2
-    from orchestrator.export_target import check_export_target
+    from orchestrator.export_target import check_export_target, check_not_read
 
     check_export_target(args.scene, args.out, args.force)
     scene = load_scene(args.scene, _overrides(args.set))
+    check_not_read(scene, args.out)
+    if args.osp is not None:  # it writes <instance>.fmu there
+        for name, spec in scene.fmus.items():
+            check_not_read(scene, args.osp / f"{name}.fmu", "--osp", copy_of=spec.path)
     if args.osp is not None:  # first: it carries input signals, which SSP refuses
         print(f"{export_osp(scene, args.osp)}: the FMUs beside it")
     out = export_ssp(scene, args.out)

@@ -41,6 +41,7 @@ from orchestrator.scenario import Scene
 from orchestrator.scenes import ANALYSES, PLOTS, REFERENCES
 from orchestrator.scenes.family import Reference
 from orchestrator.signals import scene_signals
+from orchestrator.stop_condition import keep_comparable, refuse_if_met_at_start
 from orchestrator.summary_file import not_started_summary, write_summary
 from orchestrator.system import CoupledSystem
 
@@ -198,6 +199,7 @@ def _stepped(
     try:
         guard.check()
         system.initialize(fmu_tolerance(system, scene))
+        refuse_if_met_at_start(system, scene)
         guard.check()
         execute(system, scene, recorder, stats, progress, observers=[energy])
     except FmuTerminated as exc:  # as FMPy does: the run ends there, with what it has
@@ -231,6 +233,8 @@ def _stepped(
             quantities, accuracy, ref = _analyse(
                 scene, out, recorder, data, energy, status, options, notes
             )
+            if ref is not None:
+                keep_comparable(scene, stats, ref, accuracy, notes, reached[0])
     except Interrupted as exc:
         if status == "completed":
             status = "interrupted"
