@@ -385,7 +385,7 @@ class _Loader:
         path = (self.path.parent / text).resolve()
         if path == self.path.resolve():
             raise self.fail("scene.design", "names the scene file itself; expected a design file")
-        raw = read_toml(path)
+        raw = read_toml(self.path.parent / text)  # an error names the file as written
         if not isinstance(raw.get("design"), dict):
             raise ScenarioError(path, "design", "missing; expected a [design] table")
         out: dict[str, Any] = {}

@@ -383,7 +383,7 @@ def _csv(reader: Reader, raw: dict[str, Any], key: str, var: Any):
     except FileNotFoundError:
         raise reader.fail(fkey, f"no CSV file at {path}") from None
     except NotARegularFile as exc:
-        raise reader.fail(fkey, f"{path} {exc.strerror}") from None
+        raise reader.fail(fkey, f"{reader.scene_path.parent / text} {exc.strerror}") from None
     except OSError as exc:
         raise reader.fail(fkey, f"cannot read {path}: {exc.strerror or exc}") from None
     try:
