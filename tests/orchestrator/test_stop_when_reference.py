@@ -63,8 +63,8 @@ def test_the_crossing_is_where_the_closed_form_meets_the_condition(tmp_path: Pat
 
 
 def test_a_condition_met_at_the_start_is_refused(tmp_path: Path, capsys) -> None:
-    argv = ["run", str(TWO), "--output", str(tmp_path), "--no-progress", "--in-process",
-            "--set", "scene.stop_when.signal=a.phi", "--set", "scene.stop_when.above=-1"]  # fmt: skip
+    condition = ["--set", "scene.stop_when.signal=a.phi", "--set", "scene.stop_when.above=-1"]
+    argv = ["run", str(TWO), "--output", str(tmp_path), "--no-progress", "--in-process", *condition]
     assert main(argv) == 1
     first = capsys.readouterr().out.splitlines()[0]
     assert first == (
