@@ -29,6 +29,7 @@ from orchestrator.flight import announce_run, summary_written
 from orchestrator.fmu_instance import FmuTerminated, file_sha256
 from orchestrator.fmu_log import FmuLog
 from orchestrator.interrupt import Interrupted, SignalGuard, catching_signals, signal_name
+from orchestrator.last_success import record_last_success
 from orchestrator.masters.regime_aware_choice import fmu_tolerance
 from orchestrator.observers import EnergyBalance
 from orchestrator.output_lock import OutputLock
@@ -205,7 +206,8 @@ def _stepped(
     except FmuTerminated as exc:  # as FMPy does: the run ends there, with what it has
         message = str(exc)
         notes.append(message)
-        reached[0] = exc.time
+        reached[0], unrecorded = record_last_success(system, recorder, exc)
+        notes.extend([unrecorded] if unrecorded else [])
     except RunError as exc:
         status, message = "failed", str(exc)
         if exc.time is not None:
