@@ -193,7 +193,9 @@ def _stepped(
     """Step ``system`` to the end, then analyse, summarize and return the run (the FMUs
     stay alive: the caller closes them)."""
     status, message = "completed", ""
-    notes: list[str] = []
+    # a signal file read in FMPy's format, without units: said where the run is reported
+    signals = meta.get("signals", {})
+    notes = [f"signal {k}: {v['units']}" for k, v in signals.items() if "units" in v]
     phases = options.phases
     cosim = phases.timed("co-simulation (initialize, step)")
     cosim.__enter__()
