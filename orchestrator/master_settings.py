@@ -27,6 +27,8 @@ COMMON_KEYS = ("algorithm", "order")
 #: The smallest master.tolerance taken: relative coupling errors of 1e-12 over steps of
 #: 1e-14 s (master.min_step's default) are already near double precision's 2.2e-16.
 MIN_TOLERANCE = 1e-12
+#: The largest: an error as large as the quantity itself controls nothing.
+MAX_TOLERANCE = 1.0
 #: Settings where 0 means "none" rather than being out of range.
 OFF_AT_ZERO = ("call_timeout",)
 #: How long one FMI call may take before the run's supervisor ends it [s] (README, "A
@@ -190,6 +192,12 @@ class RegimeAwareSettings:
                 "tolerance",
                 f"must be at least {MIN_TOLERANCE:g} (a smaller one asks for steps below the "
                 f"resolution of the time in double precision), got {settings.tolerance:g}",
+            )
+        if settings.tolerance > MAX_TOLERANCE:
+            raise SettingError(
+                "tolerance",
+                f"must be at most {MAX_TOLERANCE:g} (an error as large as the quantity "
+                f"controls nothing), got {settings.tolerance:g}",
             )
         if "min_step" in options and settings.min_step > step:
             raise SettingError(

@@ -29,6 +29,7 @@ from orchestrator.flight import announce_run, summary_written
 from orchestrator.fmu_instance import FmuTerminated, file_sha256
 from orchestrator.fmu_log import FmuLog
 from orchestrator.interrupt import Interrupted, SignalGuard, catching_signals, signal_name
+from orchestrator.last_success import record_last_success
 from orchestrator.masters.regime_aware_choice import fmu_tolerance
 from orchestrator.observers import EnergyBalance
 from orchestrator.output_lock import OutputLock
@@ -41,6 +42,7 @@ from orchestrator.scenario import Scene
 from orchestrator.scenes import ANALYSES, PLOTS, REFERENCES
 from orchestrator.scenes.family import Reference
 from orchestrator.signals import scene_signals
+from orchestrator.stop_condition import keep_comparable, refuse_if_met_at_start
 from orchestrator.summary_file import not_started_summary, write_summary
 from orchestrator.system import CoupledSystem
 
@@ -91,7 +93,8 @@ def run_scene(
     """
     out = Path(output_dir) if output_dir else scene.output_dir
     options = _Options(compare_reference, plots, cache_dir, reference_cache, Phases())
-    with catching_signals() as guard, OutputLock(out):
+    about = {"scene": scene.name, "scene_file": str(scene.path), "stop": scene.stop}
+    with catching_signals() as guard, OutputLock(out, about):
         announce_run(scene, out)  # for a supervisor, should this process crash
         return _run_locked(scene, out, cache_dir, show_progress, options, guard)
 
@@ -190,19 +193,23 @@ def _stepped(
     """Step ``system`` to the end, then analyse, summarize and return the run (the FMUs
     stay alive: the caller closes them)."""
     status, message = "completed", ""
-    notes: list[str] = []
+    # a signal file read in FMPy's format, without units: said where the run is reported
+    signals = meta.get("signals", {})
+    notes = [f"signal {k}: {v['units']}" for k, v in signals.items() if "units" in v]
     phases = options.phases
     cosim = phases.timed("co-simulation (initialize, step)")
     cosim.__enter__()
     try:
         guard.check()
         system.initialize(fmu_tolerance(system, scene))
+        refuse_if_met_at_start(system, scene)
         guard.check()
         execute(system, scene, recorder, stats, progress, observers=[energy])
     except FmuTerminated as exc:  # as FMPy does: the run ends there, with what it has
         message = str(exc)
         notes.append(message)
-        reached[0] = exc.time
+        reached[0], unrecorded = record_last_success(system, recorder, exc)
+        notes.extend([unrecorded] if unrecorded else [])
     except RunError as exc:
         status, message = "failed", str(exc)
         if exc.time is not None:
@@ -230,6 +237,8 @@ def _stepped(
             quantities, accuracy, ref = _analyse(
                 scene, out, recorder, data, energy, status, options, notes
             )
+            if ref is not None:
+                keep_comparable(scene, stats, ref, accuracy, notes, reached[0])
     except Interrupted as exc:
         if status == "completed":
             status = "interrupted"

@@ -32,6 +32,7 @@ from orchestrator.master_settings import (
     step_key,
 )
 from orchestrator.model_info import ModelInfo, ModelInfoError, VariableInfo, model_info
+from orchestrator.regular_files import TOML_LIMIT, NotARegularFile, read_regular
 from orchestrator.scenes import ANALYSES, REFERENCES, family, shared_parameters
 from orchestrator.scenes.family import Option, SharedParameter
 from orchestrator.signals import (
@@ -197,7 +198,7 @@ def scene_from_table(
 def read_toml(path: Path) -> dict[str, Any]:
     """The parsed file, or a ScenarioError saying in one line why it cannot be read."""
     try:
-        text = path.read_bytes().decode("utf-8")
+        text = read_regular(path, TOML_LIMIT).decode("utf-8")
     except FileNotFoundError:
         raise ScenarioError(path, "", "file not found") from None
     except IsADirectoryError:
@@ -206,6 +207,8 @@ def read_toml(path: Path) -> dict[str, Any]:
         raise ScenarioError(
             path, "", f"not UTF-8 text (byte {exc.start}): expected a TOML scenario file"
         ) from None
+    except NotARegularFile as exc:
+        raise ScenarioError(path, "", str(exc.strerror)) from None
     except OSError as exc:
         raise ScenarioError(path, "", f"cannot read: {exc.strerror or exc}") from None
     try:
@@ -382,7 +385,7 @@ class _Loader:
         path = (self.path.parent / text).resolve()
         if path == self.path.resolve():
             raise self.fail("scene.design", "names the scene file itself; expected a design file")
-        raw = read_toml(path)
+        raw = read_toml(self.path.parent / text)  # an error names the file as written
         if not isinstance(raw.get("design"), dict):
             raise ScenarioError(path, "design", "missing; expected a [design] table")
         out: dict[str, Any] = {}

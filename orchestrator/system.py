@@ -263,10 +263,20 @@ class CoupledSystem:
         drive = self._drive
         if drive is None:
             self.instances[i].do_step(t, h)
-        else:  # the signals' values at the step start; after the step, at its end
+        else:  # the signals' values at the step start, held over it (as FMPy, libcosim)
             drive(i, t)
             self.instances[i].do_step(t, h)
-            drive(i, t + h)
+
+    def jump_signals(self, t: float) -> None:
+        """At a signal's jump at t, located as a switch: every driven input takes its value
+        after the jump (the row after the switch shows it, the exchange there carries it),
+        and what depends on it is read again."""
+        if self._drive is None:
+            return
+        for i in range(len(self.instances)):
+            self._drive(i, t)
+        for i in self.input_dependent():
+            self.read(i)
 
     def record_row(self, t: float) -> list[float]:
         row = [t]

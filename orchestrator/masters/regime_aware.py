@@ -162,6 +162,8 @@ class RegimeAwareMaster:
             self.guard.smooth_step()
             # A regime that changed without a located switch changed at the step start.
             return MacroStep(end, h, changes_at=t, regimes_before=before.regimes)
+        if system.signals and system.signals.jump_at(end):
+            system.jump_signals(end)  # held over the step, the signal jumps at its end
         stats.iterations += settle(system, cfg.max_iterations) - 1
         changes = self.guard.note_changes(before)
         scheme.switched(trial, stats.do_steps - do_steps)

@@ -36,6 +36,9 @@ class Reference:
     wall_time: float = 0.0
     #: times the signals are known for (None: any time); outside, they are not compared
     t_range: tuple[float, float] | None = None
+    #: the headline is where the scene's stop_when condition is met (else at scene.stop):
+    #: a run that stopped on its condition is compared with it (orchestrator.stop_condition)
+    at_stop_when: bool = False
 
 
 @dataclass(frozen=True)

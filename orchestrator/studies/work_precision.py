@@ -28,6 +28,7 @@ from orchestrator.errors import ScenarioError
 from orchestrator.masters import TOLERANCE_MASTERS
 from orchestrator.run import reference_of
 from orchestrator.scenario import Scene, load_scene
+from orchestrator.setting_limits import check_step_factors, check_tolerances, check_workers
 from orchestrator.studies.jobs import Job, JobResult, run_jobs
 from orchestrator.studies.monolithic_curve import (
     CURVE_TOLERANCES,
@@ -199,9 +200,14 @@ def work_precision(
     timed ``monolithic_repeats`` times, in this process).  The runs go in rounds, each
     round the monolithic curve once and then every master setting once, so that the two
     sides of each ratio sample the same spells of a shared machine."""
+    check_tolerances(tolerances, "--tolerances")
+    check_tolerances(start_hold_tolerances, "--start-hold-tolerances")
+    check_tolerances(monolithic_tolerances, "--monolithic-tolerances")
+    check_workers(workers)
     scene = load_scene(scene_path, overrides)
     if not scene.reference:
         raise ScenarioError(scene_path, "report.reference", "missing; the report needs a reference")
+    check_step_factors(step_factors, scene.master.step, scene.stop - scene.start)
     out_dir = Path(out_dir or Path("runs") / f"{scene.name}_work_precision")
     out_dir.mkdir(parents=True, exist_ok=True)
     reference = reference_of(scene)

@@ -169,6 +169,7 @@ FAULTS = (
     "long_error",  # doStep logs 2000 lines, then 100000 characters, and returns fmi2Error
     "by_n_sub",  # n_sub 101, 102, 103: segfault, hang, stop; others: no fault
     "terminate_segfault",  # fmi2Terminate segfaults
+    "terminate_after",  # doStep completes its step, then returns fmi2Discard, terminated
 )
 
 

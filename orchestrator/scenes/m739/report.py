@@ -198,7 +198,10 @@ def reference_from(
             for te, a, b in getattr(result, "train_log", ())
         ]
     events.sort(key=lambda e: e[0])
-    return Reference(headline=headline, signals=signals, events=events, t_range=t_range)
+    # The monolithic model ends at arming, as a scene does on its stop_when.
+    return Reference(
+        headline=headline, signals=signals, events=events, t_range=t_range, at_stop_when=True
+    )
 
 
 def plot(scene: Scene, header: list[str], data: np.ndarray, path: Path) -> None:
