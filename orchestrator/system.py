@@ -53,7 +53,8 @@ class CoupledSystem:
         self.instances: list[FmuInstance] = []
         paths = {n: spec.path for n, spec in scene.fmus.items()} | (fmu_paths or {})
         self.paths: dict[str, Path] = paths
-        self.tolerance: float | None = None  # the integration tolerance asked of the FMUs
+        #: the integration tolerance asked of the FMUs (set by the master's setup)
+        self.tolerance: float | None = None
         try:
             for name in self.names:
                 self.instances.append(FmuInstance(name, paths[name]))
@@ -168,15 +169,14 @@ class CoupledSystem:
         return slot
 
     # -- life cycle -------------------------------------------------------------------
-    def initialize(self, tolerance: float | None = None) -> None:
-        """Instantiate every FMU with its parameters and start values; ``tolerance``: the
-        integration tolerance the master asks of the FMUs (None: their own)."""
+    def initialize(self) -> None:
+        """Instantiate every FMU with its parameters and start values, and the integration
+        tolerance the master's setup asked of them (``tolerance``; None: their own)."""
         scene = self.scene
-        self.tolerance = tolerance
         for inst in self.instances:
             spec = scene.fmus[inst.name]
             values = {**spec.parameters, **spec.inputs}
-            inst.initialize(scene.start, scene.stop, values, tolerance)
+            inst.initialize(scene.start, scene.stop, values, self.tolerance)
         # Outputs with direct feedthrough depend on inputs: settle the initial exchange.
         for _ in range(len(self.instances) + 1):
             self.read_all()

@@ -23,11 +23,13 @@ switching at one instant (chattering / Zeno) with a diagnosis.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import NamedTuple, Protocol
+from typing import Any, NamedTuple, Protocol
 
 from orchestrator.errors import RunError
 from orchestrator.master_settings import RegimeAwareSettings
+from orchestrator.masters.fixed_step import FixedStepMaster
 from orchestrator.masters.macro_step import MacroStep
 from orchestrator.masters.switches import (
     ChatteringGuard,
@@ -40,6 +42,35 @@ from orchestrator.masters.switches import (
 )
 from orchestrator.recorder import StepStats
 from orchestrator.system import CoupledSystem
+
+
+@dataclass
+class RegimeAwareStats(StepStats):
+    """The regime-aware master's statistics: the counters, its scheme and its own counts."""
+
+    input_hold: str | None = None  # the scheme that ran ("auto" resolved)
+    landings: int = 0  # steps that ended on a switch (single pass)
+    landing_do_steps: int = 0  # their doSteps, rejected passes included
+    landing_do_steps_max: int = 0  # ... at most in one
+    landing_pass_do_steps_max: int = 0  # the doSteps of the accepted pass, at most
+    internal_events: int = 0  # steps that ended at an FMU's own event and switched nothing
+    jumps: int = 0  # changes that shrinking the step left as large: landed on as switches
+
+    def choices(self) -> dict[str, Any]:
+        return {} if self.input_hold is None else {"input_hold": self.input_hold}
+
+    def counts(self) -> dict[str, Any]:
+        d: dict[str, Any] = {}
+        if self.landings:
+            d["landings"] = self.landings
+            d["landing_do_steps"] = self.landing_do_steps
+            d["landing_do_steps_max"] = self.landing_do_steps_max
+            d["landing_pass_do_steps_max"] = self.landing_pass_do_steps_max
+        if self.internal_events:
+            d["internal_events"] = self.internal_events
+        if self.jumps:
+            d["jumps"] = self.jumps
+        return d
 
 
 class Estimate(NamedTuple):
@@ -94,6 +125,12 @@ class TrialScheme(Protocol):
         """The macro step is over (free what it kept)."""
 
 
+#: Makes a trial scheme: (system, settings, statistics, landing) -> TrialScheme.
+SchemeFactory = Callable[
+    [CoupledSystem, RegimeAwareSettings, "RegimeAwareStats", Landing], TrialScheme
+]
+
+
 class RestartSteps:
     """The first step after a switch, per combination of regimes entered: a ``fraction`` of
     the step proposed there before, at least master.first_step.  With ``zero_error_only``
@@ -121,22 +158,63 @@ class RestartSteps:
 class RegimeAwareMaster:
     """Accepts, rejects and lands the trials of one scheme; see the module doc."""
 
+    name = "regime-aware"
+
     def __init__(
         self,
-        system: CoupledSystem,
         settings: RegimeAwareSettings,
-        stats: StepStats,
-        scheme: TrialScheme,
-        landing: Landing,
+        system: CoupledSystem,
+        trials: SchemeFactory,
     ) -> None:
-        self.system, self.settings, self.stats = system, settings, stats
-        self.scheme, self.landing = scheme, landing
+        """``trials`` makes the trial scheme (masters/midpoint_trial.py, single_pass.py) at
+        the start."""
+        self.system, self.settings, self.trials = system, settings, trials
+        self.stats = RegimeAwareStats()
         self.h = settings.first_step  # the step the next macro step tries first
-        self.guard = ChatteringGuard(system, landing.instant, settings.max_events_per_step)
+        self.scheme: TrialScheme | None = None  # made at the start (it reads the FMUs)
+        self.landing = Landing.of(settings)
+        self.guard = ChatteringGuard(system, self.landing.instant, settings.max_events_per_step)
+        #: the Jacobi run instead where an FMU's restore does not reproduce its step
+        self.fallback: FixedStepMaster | None = None
+
+    def setup(self) -> None:
+        """The single pass asks its FMUs to integrate below its own tolerance; the midpoint
+        hold leaves them at theirs (their validated numbers stay as they are)."""
+        if self.settings.single_pass:
+            self.system.tolerance = self.settings.single_pass_control.fmu_tolerance(
+                self.settings.tolerance
+            )
+
+    def start(self, t: float, stop: float) -> None:
+        """Check the foreign FMUs' restores, then make the trial scheme."""
+        cfg, system = self.settings, self.system
+        # A restore that does not reproduce a step would make every rollback change the
+        # answer: such an FMU is not rolled back, and no FMU is, as no trial could be retaken.
+        faults = system.restore_faults(t, cfg.first_step)
+        if faults:
+            for name, fault in faults.items():
+                self.stats.warnings.append(
+                    f"FMU {name!r}: restoring its state does not reproduce its step ({fault}): "
+                    f"it is not rolled back; the regime-aware master runs {cfg.jacobi_words()}"
+                )
+            self.fallback = FixedStepMaster(cfg.jacobi(), system, False, self.stats)
+            self.fallback.start(t, stop)
+            return
+        self.stats.input_hold = cfg.input_hold
+        self.scheme = self.trials(system, cfg, self.stats, self.landing)
+
+    @property
+    def ran(self) -> tuple[str, Any]:
+        """The algorithm and the settings that ran (the fallback's, where it ran)."""
+        if self.fallback is not None:
+            return "jacobi", self.fallback.settings
+        return self.name, self.settings
 
     def step(self, t: float, stop: float) -> MacroStep:
         """One accepted macro step from t: onto the first switch inside it (then the
         exchange there is settled), or as long as the error test allows."""
+        if self.fallback is not None:
+            return self.fallback.step(t, stop)
         cfg, system, stats, scheme = self.settings, self.system, self.stats, self.scheme
         # Ends on an input signal's breakpoint; its hold error within the tolerance.
         h = system.signals.clip(t, min(self.h, stop - t), cfg.tolerance)
@@ -169,7 +247,7 @@ class RegimeAwareMaster:
         # output jumps) with no regime change: landed on, not counted as a switch.
         internal_only = trial.internal and not changes
         if internal_only:
-            stats.extra["internal_events"] = stats.extra.get("internal_events", 0) + 1
+            stats.internal_events += 1
         failure = self.guard.switch_step(h, end)
         if trial.internal:
             # The rates go on: so does the step.
@@ -217,7 +295,7 @@ class RegimeAwareMaster:
                 as_large = last_ratio is not None and ratio > control.jump_ratio * last_ratio
                 stalled = stalled + 1 if as_large else 0
                 if stalled >= control.jump_shrinks:
-                    self.stats.extra["jumps"] = self.stats.extra.get("jumps", 0) + 1
+                    self.stats.jumps += 1
                     # Land after the jump and treat it as a switch.
                     return trial, t + h
                 last_ratio = ratio

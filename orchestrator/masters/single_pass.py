@@ -48,9 +48,8 @@ from orchestrator.master_settings import RegimeAwareSettings
 from orchestrator.masters.copies import OWN_SUFFIX, Copy, angles_with_speeds, copied_inputs
 from orchestrator.masters.held_inputs import HeldInputs
 from orchestrator.masters.input_extrapolation import InputExtrapolation
-from orchestrator.masters.regime_aware import Estimate, RestartSteps, Trial
+from orchestrator.masters.regime_aware import Estimate, RegimeAwareStats, RestartSteps, Trial
 from orchestrator.masters.switches import Landing, Readings, StepStart, Switch, switch_time
-from orchestrator.recorder import StepStats
 from orchestrator.system import CoupledSystem
 
 #: Name of the Integer input by which an FMU offers to end a step at its first event, and
@@ -77,7 +76,7 @@ class SinglePassTrials:
         self,
         system: CoupledSystem,
         settings: RegimeAwareSettings,
-        stats: StepStats,
+        stats: RegimeAwareStats,
         landing: Landing,
     ) -> None:
         self.system, self.settings, self.stats, self.landing = system, settings, stats, landing
@@ -283,10 +282,8 @@ class SinglePassTrials:
     def _count_landing(self, do_steps: int, pass_do_steps: int) -> None:
         """Step statistics of the steps that ended on a switch: how many, their doSteps
         (rejected passes included) in all and at most."""
-        extra = self.stats.extra
-        extra["landings"] = extra.get("landings", 0) + 1
-        extra["landing_do_steps"] = extra.get("landing_do_steps", 0) + do_steps
-        extra["landing_do_steps_max"] = max(extra.get("landing_do_steps_max", 0), do_steps)
-        extra["landing_pass_do_steps_max"] = max(
-            extra.get("landing_pass_do_steps_max", 0), pass_do_steps
-        )
+        stats = self.stats
+        stats.landings += 1
+        stats.landing_do_steps += do_steps
+        stats.landing_do_steps_max = max(stats.landing_do_steps_max, do_steps)
+        stats.landing_pass_do_steps_max = max(stats.landing_pass_do_steps_max, pass_do_steps)

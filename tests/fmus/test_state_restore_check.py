@@ -102,7 +102,7 @@ def test_a_faulty_restore_is_found_and_not_relied_on(
     _, faulty = controllers
     jacobi = run(tmp_path, faulty, "jacobi")
     ours = run(tmp_path, faulty, "regime-aware")
-    warnings = ours.stats.extra.get("warnings", [])
+    warnings = ours.stats.warnings
     assert len(warnings) == 1  # and none about what the regime-aware master holds
     assert warnings[0].startswith(
         "FMU 'c': restoring its state does not reproduce its step (output y differs by "
@@ -136,6 +136,6 @@ def test_a_faithful_foreign_fmu_is_still_rolled_back(
 ) -> None:
     faithful, _ = controllers
     ours = run(tmp_path, faithful, "regime-aware", stop=0.01)
-    assert not any("restoring its state" in w for w in ours.stats.extra.get("warnings", []))
+    assert not any("restoring its state" in w for w in ours.stats.warnings)
     assert ours.stats.rollbacks > 0
     assert speed_error(ours) < 1e-4
