@@ -377,8 +377,7 @@ def _noted(notes: list[str], what: str, header: list[str]) -> Iterator[None]:
 def master_ran(master: Master) -> dict[str, Any]:
     """The algorithm and every setting that ran ("auto" resolved, defaults filled in; the
     Jacobi run instead where the regime-aware master could not roll back)."""
-    name, settings = getattr(master, "ran", (master.name, master.settings))
-    return {"algorithm": name, **as_record(settings)}
+    return {"algorithm": master.name, **as_record(master.settings)}
 
 
 def fmu_warnings(system: CoupledSystem) -> dict[str, FmuLog]:

@@ -140,7 +140,8 @@ class SinglePassTrials:
 
     def switched(self, accepted: Trial, do_steps: int) -> None:
         if not accepted.internal:
-            self._count_landing(do_steps, accepted.do_steps)
+            # Its doSteps (rejected passes included) and the accepted pass's.
+            self.stats.landed(do_steps, accepted.do_steps)
         self.extrapolation.switched(accepted.internal)
 
     def left_row(self, accepted: Trial, switch_at: float, start: StepStart) -> None:
@@ -278,12 +279,3 @@ class SinglePassTrials:
                 worst = max(worst, miss / (tol * travel))
         unannotated = held.change_ratio(before, held.unannotated, tol) if held.unannotated else 0.0
         return Estimate(max(worst, unannotated), unannotated > worst or not ex.second_order)
-
-    def _count_landing(self, do_steps: int, pass_do_steps: int) -> None:
-        """Step statistics of the steps that ended on a switch: how many, their doSteps
-        (rejected passes included) in all and at most."""
-        stats = self.stats
-        stats.landings += 1
-        stats.landing_do_steps += do_steps
-        stats.landing_do_steps_max = max(stats.landing_do_steps_max, do_steps)
-        stats.landing_pass_do_steps_max = max(stats.landing_pass_do_steps_max, pass_do_steps)
