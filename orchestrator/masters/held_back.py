@@ -15,23 +15,21 @@ outputs over its step bounds the next step (first order: it cannot be retaken).
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
 
 from orchestrator.master_settings import RegimeAwareSettings
 from orchestrator.masters.switches import Readings
+from orchestrator.recorder import StepStats
 from orchestrator.system import CoupledSystem
-
-if TYPE_CHECKING:  # the master's module imports this one
-    from orchestrator.masters.regime_aware import RegimeAwareStats
 
 
 class HeldBack:
     """Finds the FMUs not to roll back, steps them and bounds the next step by them."""
 
     def __init__(
-        self, system: CoupledSystem, settings: RegimeAwareSettings, stats: RegimeAwareStats
+        self, system: CoupledSystem, settings: RegimeAwareSettings, stats: StepStats
     ) -> None:
         self.system, self.settings, self.stats = system, settings, stats
+        self.names: list[str] = []  # held back, in the order found
         self.scale: dict[tuple[int, int], float] = {}  # running scale of their outputs
 
     def start(self, t: float) -> None:
@@ -55,7 +53,7 @@ class HeldBack:
     def _hold(self, i: int, fault: str, when: str) -> None:
         name = self.system.names[i]
         self.system.hold_back(i)
-        self.stats.not_rolled_back.append(name)
+        self.names.append(name)
         self.stats.warnings.append(
             f"FMU {name!r}: restoring its state does not reproduce it ({fault}, found {when}): "
             "it is no longer rolled back; it is stepped once per macro step with the inputs "

@@ -196,6 +196,7 @@ class RegimeAwareMaster:
         self.guard = ChatteringGuard(system, self.landing.instant, settings.max_events_per_step)
         #: foreign FMUs whose restore does not reproduce their state: not rolled back
         self.held_back = HeldBack(system, settings, self.stats)
+        self.stats.not_rolled_back = self.held_back.names
 
     def setup(self) -> None:
         """The single pass asks its FMUs to integrate below its own tolerance; the midpoint

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from orchestrator.lazy import resolve
 from orchestrator.master_settings import (
@@ -24,20 +24,18 @@ from orchestrator.master_settings import (
     kinds_of,
 )
 
-if TYPE_CHECKING:  # the masters import the system, which imports the scene loader
-    from orchestrator.masters.macro_step import Master
-    from orchestrator.system import CoupledSystem
-
 
 @dataclass(frozen=True)
 class Algorithm:
     """One master algorithm: its settings class and its factory, (settings, system) ->
-    Master, as "package.module:function" or the callable itself."""
+    Master, as "package.module:function" or the callable itself.  (Typed loosely: the
+    masters and the system import the scene loader, which reads this registry.)"""
 
     settings: type
-    factory: str | Callable[[Any, CoupledSystem], Master]
+    factory: str | Callable[[Any, Any], Any]
 
-    def make(self, settings: Settings, system: CoupledSystem) -> Master:
+    def make(self, settings: Settings, system: Any) -> Any:
+        """The master of one run (masters/macro_step.py, ``Master``) on the coupled system."""
         factory = resolve(self.factory) if isinstance(self.factory, str) else self.factory
         return factory(settings, system)
 
