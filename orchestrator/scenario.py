@@ -20,16 +20,18 @@ from fmus.registry import FMU_RECORDS
 from orchestrator.errors import ScenarioError
 from orchestrator.lazy import resolve
 from orchestrator.master_settings import (
-    ALGORITHMS,
     COMMON_KEYS,
-    SETTING_KINDS,
-    STEP_KEYS,
     FixedStepSettings,
-    MasterSettings,
     SettingError,
-    master_settings,
+    Settings,
     read_options,
+)
+from orchestrator.masters.registry import (
+    ALGORITHMS,
+    setting_kinds,
+    settings_of,
     step_key,
+    step_keys,
 )
 from orchestrator.model_info import ModelInfo, ModelInfoError, VariableInfo, model_info
 from orchestrator.regular_files import TOML_LIMIT, NotARegularFile, read_regular
@@ -88,7 +90,7 @@ class MasterSpec:
     step: float
     order: tuple[str, ...]
     options: dict[str, Any] = field(default_factory=dict)  # as the scene wrote them (SI)
-    settings: MasterSettings | None = None  # the algorithm's, defaults filled in
+    settings: Settings | None = None  # the algorithm's, defaults filled in
 
     @property
     def own_step(self) -> tuple[str, float]:
@@ -721,7 +723,8 @@ class _Loader:
             )
 
     def master(self, node: dict[str, Any], fmus: dict[str, FmuSpec], duration: float) -> MasterSpec:
-        self.check_keys(node, "master", {*COMMON_KEYS, *STEP_KEYS, *SETTING_KINDS})
+        kinds = setting_kinds()
+        self.check_keys(node, "master", {*COMMON_KEYS, *step_keys(), *kinds})
         if "algorithm" not in node:
             raise self.fail("master.algorithm", "missing")
         algorithm = self.string(node, "algorithm", "master.algorithm")
@@ -730,7 +733,7 @@ class _Loader:
                 "master.algorithm", f"unknown {algorithm!r}; expected one of {list(ALGORITHMS)}"
             )
         steps = {}
-        for k in STEP_KEYS:
+        for k in step_keys():
             if k in node:
                 steps[k] = value = self.quantity(node[k], f"master.{k}", "s")
                 if not value > 0.0:
@@ -751,9 +754,10 @@ class _Loader:
             and sorted(order) == sorted(fmus)
         ):
             raise self.fail("master.order", f"expected every instance once, from {sorted(fmus)}")
+        fixed_step = steps.get(FixedStepSettings.STEP_KEY, step)
         try:
-            options = read_options(node, self.quantity)
-            settings = master_settings(algorithm, step, duration, options)
+            options = read_options(node, self.quantity, kinds)
+            settings = settings_of(algorithm, step, duration, options, fixed_step)
         except SettingError as exc:
             raise self.fail(f"master.{exc.key}", str(exc)) from None
         largest = getattr(settings, "longest_step", None)  # a master that varies its step
@@ -771,7 +775,6 @@ class _Loader:
                     f"{duration / largest:.3g} macro steps, more than the limit "
                     f"{MAX_STEPS:.0e}: the run would not finish (--force to run it)",
                 )
-        fixed_step = steps.get(FixedStepSettings.STEP_KEY, step)
         return MasterSpec(algorithm, fixed_step, tuple(order), options, settings)
 
     def output(self, node: dict[str, Any], fmus: dict[str, FmuSpec], name: str):
@@ -978,12 +981,13 @@ class _Loader:
                 raise self.fail(key, f"no FMU of the scene shares a parameter {parts[1]!r}")
             instance, _, name = targets[0]
             return fmus[instance].model.variables[name].unit or "1"
-        if len(parts) == 2 and parts[0] == "master" and parts[1] in SETTING_KINDS:
-            if SETTING_KINDS[parts[1]].choices:
+        kinds = setting_kinds()
+        if len(parts) == 2 and parts[0] == "master" and parts[1] in kinds:
+            if kinds[parts[1]].choices:
                 raise self.fail(key, f"cannot sweep {dotted!r}: it is a word, not a number")
-            return SETTING_KINDS[parts[1]].unit
+            return kinds[parts[1]].unit
         if len(parts) == 2 and parts[0] == "master" and parts[1] in COMMON_KEYS:
-            return "s" if parts[1] == "step" else None
+            return None
         if len(parts) == 2 and parts[0] == "scene" and parts[1] in ("start", "stop"):
             return "s"
         raise self.fail(

@@ -32,9 +32,8 @@ from typing import Any, NamedTuple
 
 from orchestrator.master_settings import RegimeAwareSettings
 from orchestrator.masters.held_inputs import HeldInputs
-from orchestrator.masters.regime_aware import Estimate, RestartSteps, Trial
+from orchestrator.masters.regime_aware import Estimate, RegimeAwareStats, RestartSteps, Trial
 from orchestrator.masters.switches import Landing, StepStart, Switch, back_to_start, switch_time
-from orchestrator.recorder import StepStats
 from orchestrator.system import CoupledSystem
 
 
@@ -74,7 +73,7 @@ class MidpointTrials:
         self,
         system: CoupledSystem,
         settings: RegimeAwareSettings,
-        stats: StepStats,
+        stats: RegimeAwareStats,
         landing: Landing,
     ) -> None:
         self.system, self.settings, self.stats, self.landing = system, settings, stats, landing
@@ -87,7 +86,7 @@ class MidpointTrials:
         control = settings.control
         self.restart = RestartSteps(settings.first_step, control.zero_error_restart, True)
         if self.held.black_boxes and self.midpoint:
-            stats.extra.setdefault("warnings", []).append(
+            stats.warnings.append(
                 f"FMU {', '.join(map(repr, self.held.black_boxes))} declares no sampled "
                 "inputs, event indicators or regimes: its inputs are held at the step start "
                 "(first order in the step, the step sized by their change) and its internal "

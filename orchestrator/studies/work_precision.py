@@ -25,7 +25,7 @@ import numpy as np
 
 from orchestrator.accuracy import compare
 from orchestrator.errors import ScenarioError
-from orchestrator.masters import TOLERANCE_MASTERS
+from orchestrator.masters.registry import tolerance_masters
 from orchestrator.run import reference_of
 from orchestrator.scenario import Scene, load_scene
 from orchestrator.setting_limits import check_step_factors, check_tolerances, check_workers
@@ -157,7 +157,7 @@ def sweep_jobs(
             if h <= scene.stop - scene.start:
                 overrides = {"master.algorithm": master, "master.step": h}
                 jobs.append(job(overrides, f"{master}_h{h:.3e}", master))
-    for master in TOLERANCE_MASTERS:
+    for master in tolerance_masters():
         for tol in tolerances:
             # The midpoint hold: the single pass ("auto" picks it where a copy judges the
             # coupling) has a line of its own.

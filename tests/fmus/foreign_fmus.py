@@ -551,17 +551,22 @@ PI_CONTROLLER_VARIABLES = (
 )
 
 
-def build_pi_controller(dest: Path, forgets_integrator: bool = False) -> Path:
+def build_pi_controller(
+    dest: Path, forgets_integrator: bool = False, after_jump: bool = False
+) -> Path:
     """Compile PiController (its initialization fails unless the set point u_s is 0) and
     pack it as ``dest/PiController.fmu``; return its path.  ``forgets_integrator``: its
     fmi2SetFMUstate restores everything but the integral x (``PiController-forgets.fmu``),
-    a state restore that does not reproduce a step."""
-    suffix = "-forgets" if forgets_integrator else ""
+    a state restore that does not reproduce a step; with ``after_jump`` only once the set
+    point has left its value at the first step (``PiController-forgets-after-jump.fmu``)."""
+    suffix = ("-forgets" if forgets_integrator else "") + ("-after-jump" if after_jump else "")
+    defines = ["-DPI_CONTROLLER_FORGETS_INTEGRATOR"] if forgets_integrator else []
+    defines += ["-DPI_CONTROLLER_FORGETS_AFTER_JUMP"] if after_jump else []
     return _build_c_fmu(
         PI_CONTROLLER_SOURCE,
         "PiController",
         "PI_CONTROLLER_GUID",
-        ["-DPI_CONTROLLER_FORGETS_INTEGRATOR"] if forgets_integrator else [],
+        defines,
         _pi_controller_model_description,
         Path(dest) / f"PiController{suffix}.fmu",
     )

@@ -139,7 +139,7 @@ def test_regime_aware_master_steps_a_black_box_with_rollback(tmp_path, foreign) 
     assert r.status == "completed", r.message
     assert r.stats.rollbacks > 0
     # It cannot know which inputs are sampled states: it says so and holds them.
-    (warning,) = r.stats.extra["warnings"]
+    (warning,) = r.stats.warnings
     assert "'c' declares no sampled inputs" in warning
     # Against the closed form of the two bodies (averaging the black box's inputs would
     # have missed it by 0.3 at this tolerance; held, the error is 2.5e-5).
@@ -152,7 +152,7 @@ def test_regime_aware_master_steps_a_black_box_with_rollback(tmp_path, foreign) 
 def test_regime_aware_master_says_what_it_gives_up_without_state(tmp_path, foreign, fmu) -> None:
     path = write_scene(tmp_path, foreign_scene(str(foreign / fmu), "regime-aware"))
     r = run_scene(load_scene(path), output_dir=tmp_path / "run", show_progress=False, plots=False)
-    (warning,) = r.stats.extra["warnings"]
+    (warning,) = r.stats.warnings
     assert "'c' cannot save and restore its state" in warning and "fixed-step Jacobi" in warning
     assert_matches_reference(r)
 

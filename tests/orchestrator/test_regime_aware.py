@@ -73,10 +73,10 @@ def test_stop_condition_is_landed_on_exactly(tmp_path, fmu_cache) -> None:
             "scene.stop_when": STOP_AT_ONE_RADIAN,
         },
     )
-    assert ours.status == "completed" and ours.stats.extra["stopped_by_condition"]
+    assert ours.status == "completed" and ours.stats.stopped_by_condition
     assert ours.signal("a.phi")[-1] == pytest.approx(1.0, abs=1e-9)
     fixed = run(tmp_path, fmu_cache, **{"scene.stop_when": STOP_AT_ONE_RADIAN})
-    assert fixed.stats.extra["stopped_by_condition"]
+    assert fixed.stats.stopped_by_condition
     overshoot = fixed.signal("a.phi")[-1] - 1.0
     assert 0.0 < overshoot < 10.0 * 1e-4  # at most one step of about 10 rad/s x 0.1 ms
 

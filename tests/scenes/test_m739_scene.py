@@ -76,8 +76,8 @@ def test_cosimulation_matches_the_monolithic_reference(request, scheme) -> None:
 @pytest.mark.slow
 def test_the_single_pass_is_the_cheaper_at_the_same_accuracy(default_run, midpoint_run) -> None:
     # Counted, not timed: 1676 doSteps against 20448 (turns errors 2.2e-6 and 8.0e-5).
-    assert default_run.stats.extra["input_hold"] == "extrapolated"
-    assert midpoint_run.stats.extra["input_hold"] == "midpoint"
+    assert default_run.stats.input_hold == "extrapolated"
+    assert midpoint_run.stats.input_hold == "midpoint"
     assert default_run.stats.do_steps < 0.2 * midpoint_run.stats.do_steps
 
 
@@ -115,8 +115,8 @@ def test_a_coarse_tolerance_stays_accurate(tmp_path, fmu_cache, default_run) -> 
     # targets ask (measured 7.5e-5: steps bounded by the switches alone, the train's reduced
     # model in the verge), in fewer steps than at the scene's (630 against 765).
     single = run(tmp_path, fmu_cache, "coarse_single_pass", **{"master.tolerance": 1e-2})
-    assert single.stats.extra["input_hold"] == default_run.stats.extra["input_hold"]
-    assert single.stats.extra["input_hold"] == "extrapolated"
+    assert single.stats.input_hold == default_run.stats.input_hold
+    assert single.stats.input_hold == "extrapolated"
     assert single.accuracy["headline_error.turns_to_arm"] < 1e-4
     assert single.stats.steps < default_run.stats.steps
 

@@ -58,13 +58,13 @@ def test_a_switch_costs_one_doStep_of_each_fmu(tmp_path, fmu_cache) -> None:
             reference=False,
             **{"master.tolerance": tol, "scene.stop": "4 ms"},
         )
-        extra = r.stats.extra
+        stats = r.stats
         assert r.status == "completed", r.message
-        assert extra["landings"] >= 20
-        assert extra["landing_pass_do_steps_max"] == 2
+        assert stats.landings >= 20
+        assert stats.landing_pass_do_steps_max == 2
         # Passes rejected by the error test on the way included: at most 4 passes.
-        assert extra["landing_do_steps_max"] <= 8
-        assert extra["landing_do_steps"] <= 2.5 * extra["landings"]
+        assert stats.landing_do_steps_max <= 8
+        assert stats.landing_do_steps <= 2.5 * stats.landings
 
 
 @pytest.fixture(scope="module")
