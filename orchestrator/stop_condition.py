@@ -82,7 +82,7 @@ def keep_comparable(
 ) -> None:
     """Drop the headline errors of a run that stopped on its condition when the reference
     gives its headline at ``scene.stop`` instead, and say so in ``notes``."""
-    stopped = stats.extra.get("stopped_by_condition", False)
+    stopped = stats.stopped_by_condition
     if not stopped or getattr(reference, "at_stop_when", False):
         return
     dropped = [k for k in accuracy if k.startswith("headline_error")]

@@ -192,7 +192,7 @@ def test_an_fmu_without_variable_steps_is_refused_where_a_master_varies_its_step
     # The regime-aware master sizes every step: it falls back to fixed-step Jacobi, on a grid.
     path = write_scene(tmp_path, foreign_scene(str(fmu), "regime-aware"))
     r = run_scene(load_scene(path), output_dir=tmp_path / "aware", show_progress=False)
-    (warning,) = r.stats.extra["warnings"]
+    (warning,) = r.stats.warnings
     assert warning.startswith(
         "FMU 'c' cannot take communication steps of varying size "
         "(canHandleVariableCommunicationStepSize is false), which the regime-aware master needs"
