@@ -15,7 +15,7 @@ from orchestrator.interrupt import Interrupted
 from orchestrator.masters import MASTERS, MacroStep
 from orchestrator.observers import RegimeLog, StepCounter, TimeSeries
 from orchestrator.recorder import Recorder, StepStats
-from orchestrator.scenario import Scene
+from orchestrator.scene_model import Scene
 from orchestrator.system import CoupledSystem
 
 #: relative: a run this close to its stop time has reached it

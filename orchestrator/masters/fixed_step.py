@@ -13,7 +13,7 @@ import math
 from orchestrator.master_settings import FixedStepSettings
 from orchestrator.masters.macro_step import MacroStep
 from orchestrator.recorder import StepStats
-from orchestrator.scenario import Scene
+from orchestrator.scene_model import Scene
 from orchestrator.system import CoupledSystem
 
 

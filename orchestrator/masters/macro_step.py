@@ -16,7 +16,7 @@ from typing import Protocol
 
 from orchestrator.errors import RunError
 from orchestrator.recorder import StepStats
-from orchestrator.scenario import Scene
+from orchestrator.scene_model import Scene
 from orchestrator.system import CoupledSystem
 
 

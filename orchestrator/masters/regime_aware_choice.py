@@ -17,7 +17,7 @@ from orchestrator.masters.regime_aware import RegimeAwareMaster
 from orchestrator.masters.single_pass import SinglePassTrials
 from orchestrator.masters.switches import Landing
 from orchestrator.recorder import StepStats
-from orchestrator.scenario import Scene
+from orchestrator.scene_model import Scene
 from orchestrator.system import CoupledSystem
 
 

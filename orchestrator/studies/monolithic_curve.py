@@ -22,7 +22,7 @@ from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from orchestrator.scenario import Scene
+from orchestrator.scene_model import Scene
 
 #: Tolerance of the truth run (relative local error of the monolithic integrator).
 TRUTH_TOLERANCE = 1e-12

@@ -27,7 +27,8 @@ from orchestrator.accuracy import compare
 from orchestrator.errors import ScenarioError
 from orchestrator.masters import TOLERANCE_MASTERS
 from orchestrator.run import reference_of
-from orchestrator.scenario import Scene, load_scene
+from orchestrator.scenario import load_scene
+from orchestrator.scene_model import Scene
 from orchestrator.studies.jobs import Job, JobResult, run_jobs
 from orchestrator.studies.monolithic_curve import (
     CURVE_TOLERANCES,

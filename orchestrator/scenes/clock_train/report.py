@@ -29,7 +29,7 @@ from components.verge_escapement import (
     FREE,
 )
 from orchestrator.plotting import recorded
-from orchestrator.scenario import Scene
+from orchestrator.scene_model import Scene
 from orchestrator.scenes.clock_train.design import train_values, verge_data
 from orchestrator.scenes.clock_train.monolithic import ARMING_ROTOR_ANGLE, run_clock_train
 from orchestrator.scenes.family import Quantity, Reference, quantity

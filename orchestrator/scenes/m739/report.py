@@ -34,7 +34,7 @@ from orchestrator.plotting import (
     unit_label,
     window,
 )
-from orchestrator.scenario import Scene
+from orchestrator.scene_model import Scene
 from orchestrator.scenes.family import Quantity, Reference, quantity
 from orchestrator.scenes.m739.design import instances, parameter, scene_design
 from orchestrator.scenes.m739.monolithic import run_m739
