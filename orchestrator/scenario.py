@@ -39,7 +39,7 @@ from orchestrator.scene_model import (
     SweepSeries,
     SweepSpec,
 )
-from orchestrator.scenes import ANALYSES, REFERENCES, family, shared_parameters
+from orchestrator.scenes import ANALYSES, FAMILY_NAMES, REFERENCES, family, shared_parameters
 from orchestrator.scenes.family import Option, SharedParameter
 from orchestrator.signals import (
     Reader,
@@ -153,6 +153,7 @@ class _Loader:
     ) -> None:
         self.path, self.raw, self.cache_dir, self.force = path, raw, cache_dir, force
         self.span = (0.0, math.inf)  # the run's (start, stop), once [scene] is read
+        self.shared = shared_parameters(_families(raw))  # what the scene's families share
 
     def fail(self, key: str, message: str) -> ScenarioError:
         return ScenarioError(self.path, key, message)
@@ -358,12 +359,8 @@ class _Loader:
                 raise self.fail(f"{key}.fmu", str(exc)) from None
             params = self.values(entry.get("parameters", {}), f"{key}.parameters", model)
             for name, value in shared.items():
-                if _takes(component, model, shared_parameters().get(name)) or _designs(
-                    component, name
-                ):
-                    if name in params and not _takes(
-                        component, model, shared_parameters().get(name)
-                    ):
+                if _takes(component, model, self.shared.get(name)) or _designs(component, name):
+                    if name in params and not _takes(component, model, self.shared.get(name)):
                         raise self.fail(
                             f"{key}.parameters.{name}",
                             f"{name} is a quantity of the design, stated for the scene "
@@ -395,7 +392,7 @@ class _Loader:
         """A shared parameter is stated once, in [parameters], and some FMU takes it."""
         taken = {
             p.name: p
-            for p in shared_parameters().values()
+            for p in self.shared.values()
             for spec in fmus.values()
             if _takes(spec.component, spec.model, p)
         }
@@ -437,7 +434,7 @@ class _Loader:
         if len(parts) == 4 and parts[0] == "fmus" and parts[2] in ("parameters", "inputs"):
             return [(parts[1], parts[2], parts[3])]
         if len(parts) == 2 and parts[0] == "parameters":
-            shared = shared_parameters().get(parts[1])
+            shared = self.shared.get(parts[1])
             return [
                 (instance, "parameters", parts[1])
                 for instance, spec in fmus.items()
@@ -899,6 +896,16 @@ class _Loader:
         if isinstance(value, bool) or not isinstance(value, int | float):
             raise self.fail(f"sweep.values[{k}]", f"expected a number, got {value!r}")
         return float(value)
+
+
+def _families(raw: dict[str, Any]) -> tuple[str, ...]:
+    """The families a scene names ([report] family and reference), before [report] is
+    checked: a misspelt or missing name shares nothing, and is refused with [report]."""
+    report = raw.get("report")
+    if not isinstance(report, dict):
+        return ()
+    named = (report.get("family"), report.get("reference"))
+    return tuple(dict.fromkeys(n for n in named if isinstance(n, str) and n in FAMILY_NAMES))
 
 
 def _designs(component: str | None, name: str) -> bool:
