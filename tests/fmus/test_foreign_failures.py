@@ -16,7 +16,7 @@ from pathlib import Path
 import foreign_fmus
 import numpy as np
 import pytest
-from test_ssp_units import SCENE
+from foreign_fmus import TORSION_BODY_SCENE
 
 from orchestrator.errors import RunError, ScenarioError
 from orchestrator.run import run_scene
@@ -43,7 +43,9 @@ def build(tmp_path_factory: pytest.TempPathFactory):  # noqa: ANN201 - a factory
 
 
 def write_scene(d: Path, fmu: Path, name: str, record: str | None = None) -> Path:
-    text = SCENE.format(fmu=fmu, phi0=0.1).replace('name = "deg_parameter"', f'name = "{name}"')
+    text = TORSION_BODY_SCENE.format(fmu=fmu, phi0=0.1).replace(
+        'name = "deg_parameter"', f'name = "{name}"'
+    )
     if record:
         text = text.replace('"c.flange.tau"]', f'"c.flange.tau", "{record}"]')
     path = d / f"{name}.toml"
