@@ -120,3 +120,19 @@ def test_run_time_imports_are_seen(tmp_path) -> None:
 def test_a_cycle_is_found() -> None:
     graph = {"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}}
     assert _cycle(graph) == ["a", "b", "c", "a"]
+
+
+def test_no_test_module_imports_another() -> None:
+    """Shared fixtures live in conftest.py, shared texts and functions in modules whose names
+    do not start with test_: a test module is read on its own."""
+    found = []
+    for path in sorted((PROJECT_DIR / "tests").rglob("*.py")):
+        for node in ast.walk(ast.parse(path.read_text())):
+            names = []
+            if isinstance(node, ast.Import):
+                names = [a.name for a in node.names]
+            elif isinstance(node, ast.ImportFrom):
+                names = [node.module or ""]
+            tests = [n for n in names if n.rpartition(".")[2].startswith("test_")]
+            found += [f"{path.name}: {n}" for n in tests]
+    assert found == []

@@ -276,8 +276,8 @@ def test_m739_sample_that_jams_is_not_armed_with_the_reason(tmp_path: Path) -> N
 
 
 @pytest.mark.slow
-def test_m739_study_of_8_samples_within_a_minute(tmp_path: Path) -> None:
-    start = time.perf_counter()
+def test_m739_study_of_8_samples(tmp_path: Path) -> None:
+    # No time limit: a test judges results; timings are `mechcosim bench`'s.
     result = run_study(
         SCENARIOS / "m739_study.toml",
         samples=8,
@@ -285,11 +285,9 @@ def test_m739_study_of_8_samples_within_a_minute(tmp_path: Path) -> None:
         output_dir=tmp_path,
         show_progress=False,
     )
-    wall = time.perf_counter() - start
     assert [s.status for s in result.samples] == [OK] * 8
     turns = result.values("turns_to_arm")
     assert 18.0 < turns.min() and turns.max() < 34.0  # the report: 22 at mu 0.05, 31 at 0.15
-    assert wall < 60.0, wall
 
 
 @pytest.mark.slow
