@@ -17,9 +17,9 @@ import foreign_fmus
 import numpy as np
 import pytest
 from foreign_fmus import TORSION_BODY_SCENE
+from scene_run import run_file
 
 from orchestrator.errors import RunError, ScenarioError
-from orchestrator.run import run_scene
 from orchestrator.scenario import load_scene
 
 if foreign_fmus.c_compiler() is None:
@@ -65,7 +65,7 @@ def with_description(fmu: Path, target: Path, edit) -> Path:  # noqa: ANN001 - s
 
 
 def run(path: Path, out: Path, overrides: dict | None = None):  # noqa: ANN201 - RunResult
-    return run_scene(load_scene(path, overrides), output_dir=out, show_progress=False, plots=False)
+    return run_file(path, out, overrides)
 
 
 def summary(out: Path) -> dict:

@@ -7,10 +7,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from scene_run import run_file
 
 from orchestrator.errors import ScenarioError
 from orchestrator.model_info import VariableInfo
-from orchestrator.run import run_scene
 from orchestrator.scenario import load_scene
 from orchestrator.signals import InputSignals, Reader, Signal, read_signal
 
@@ -42,10 +42,7 @@ def write(tmp_path: Path, text: str, name: str = "scene.toml") -> Path:
 
 
 def run(tmp_path: Path, path: Path, **overrides):
-    scene = load_scene(path, overrides)
-    result = run_scene(scene, output_dir=tmp_path / "out", show_progress=False)
-    assert result.status == "completed", result.message
-    return result
+    return run_file(path, tmp_path / "out", overrides, completed=True)
 
 
 def motion(signal: Signal, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -9,12 +9,13 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from scene_run import run_file
 
 from components.detached_lever import DetachedLever
 from components.detached_lever_data import TABLE_I
 from components.detached_lever_design import symmetric_friction
 from orchestrator.errors import ScenarioError
-from orchestrator.run import RunResult, run_scene
+from orchestrator.run import RunResult
 from orchestrator.scenario import load_scene
 from orchestrator.scenes.detached_lever.lever import lever_scene
 
@@ -42,10 +43,7 @@ def friction(coulomb: float) -> dict[str, float]:
 
 
 def run(path: Path, out: Path, cache: Path, **overrides) -> RunResult:
-    scene = load_scene(path, overrides)
-    result = run_scene(scene, output_dir=out, cache_dir=cache, show_progress=False)
-    assert result.status == "completed", result.message
-    return result
+    return run_file(path, out, overrides, plots=True, completed=True)
 
 
 @pytest.fixture(scope="module")

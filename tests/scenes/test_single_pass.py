@@ -14,24 +14,15 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-
-from orchestrator.run import run_scene
-from orchestrator.scenario import load_scene
+from scene_run import run_file
 
 SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
 SINGLE_PASS = {"master.algorithm": "regime-aware", "master.input_hold": "extrapolated"}
 
 
 def run(tmp_path: Path, fmu_cache: Path, scene: str, reference: bool = True, **overrides):
-    loaded = load_scene(SCENARIOS / scene, {**SINGLE_PASS, **overrides})
-    return run_scene(
-        loaded,
-        output_dir=tmp_path,
-        cache_dir=fmu_cache,
-        show_progress=False,
-        compare_reference=reference,
-        plots=reference,
-    )
+    overrides = {**SINGLE_PASS, **overrides}
+    return run_file(SCENARIOS / scene, tmp_path, overrides, reference=reference, plots=reference)
 
 
 def test_a_switch_costs_one_doStep_of_each_fmu(tmp_path, fmu_cache) -> None:

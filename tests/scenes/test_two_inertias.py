@@ -9,20 +9,16 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from scene_run import run_file
 
 from components.rotational import Inertia, SpringDamperInertia
-from orchestrator.run import run_scene
-from orchestrator.scenario import load_scene
 from orchestrator.scenes.two_inertias.report import two_inertias_exact
 
 SCENE = Path(__file__).resolve().parents[2] / "scenarios" / "two_inertias.toml"
 
 
 def run(tmp_path, fmu_cache, **overrides):
-    scene = load_scene(SCENE, overrides)
-    return run_scene(
-        scene, output_dir=tmp_path / "run", cache_dir=fmu_cache, show_progress=False, plots=False
-    )
+    return run_file(SCENE, tmp_path / "run", overrides)
 
 
 def test_closed_form_conserves_momentum_and_oscillates() -> None:
