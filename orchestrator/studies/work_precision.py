@@ -87,6 +87,7 @@ class Row:
     monolithic_time: float = math.nan  # the monolithic model's time for quantity_error
     #: best wall time of the repeats (the result's own when run once)
     wall_time: float = math.nan
+    headline: Headline = NO_HEADLINE  # the family's quantity quantity_error is of
 
     @property
     def monolithic_ratio(self) -> float:
@@ -107,7 +108,7 @@ class Row:
             return ""
         return "yes" if self.error <= self.value else "no"
 
-    def as_dict(self, headline: Headline = NO_HEADLINE) -> dict[str, Any]:
+    def as_dict(self) -> dict[str, Any]:
         stats = self.result.stats
         energy = self.result.headline.get("energy_residual", {}).get("value", math.nan)
         return {
@@ -116,7 +117,7 @@ class Row:
             "value": self.value,
             "status": self.result.status,
             "wall_time": self.wall_time,
-            headline.error_column: self.quantity_error,
+            self.headline.error_column: self.quantity_error,
             "monolithic_time": self.monolithic_time,
             "monolithic_ratio": self.monolithic_ratio,
             "within_tolerance": self.within_tolerance,
@@ -243,13 +244,13 @@ def work_precision(
         # By the master, not by the keys: --set may put either key into every job.
         setting = "step" if job.label in FIXED_STEP else "tolerance"
         value = job.overrides[f"master.{setting}"]
-        row = Row(job.label, setting, value, res, accuracy, wall_time=wall)
+        row = Row(job.label, setting, value, res, accuracy, wall_time=wall, headline=headline)
         quantity = headline.quantity
         if curve is not None and res.status == "completed" and quantity in res.headline:
             row.quantity_error = curve.relative_error(float(res.headline[quantity]["value"]))
             row.monolithic_time = time_in_window(curve, row.quantity_error)
         rows.append(row)
-    records = [r.as_dict(headline) for r in rows] + monolithic_records(curve, headline)
+    records = [r.as_dict() for r in rows] + monolithic_records(curve, headline)
     _write_csv(records, out_dir / "work_precision.csv", headline)
     png = out_dir / "work_precision.png"
     plot_records(records, reference.wall_time, scene.name, png, headline)
@@ -332,9 +333,9 @@ def plot_records(
     from matplotlib.ticker import NullFormatter
 
     own = headline.error_column
-    turns = any(math.isfinite(_float(r.get(own))) for r in records)
-    fig, axes = plt.subplots(1, 2, figsize=(14 if turns else 11, 4.5))
-    panels = ("trajectory_error", own if turns else "headline_error")
+    has_own = any(math.isfinite(_float(r.get(own))) for r in records)
+    fig, axes = plt.subplots(1, 2, figsize=(14 if has_own else 11, 4.5))
+    panels = ("trajectory_error", own if has_own else "headline_error")
     for ax, error in zip(axes, panels, strict=True):
         for master in dict.fromkeys(r["master"] for r in records):
             pts = [
