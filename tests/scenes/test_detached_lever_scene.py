@@ -42,13 +42,13 @@ def friction(coulomb: float) -> dict[str, float]:
     return {f"fmus.lever.parameters.{k}": v for k, v in symmetric_friction(coulomb).items()}
 
 
-def run(path: Path, out: Path, cache: Path, **overrides) -> RunResult:
-    return run_file(path, out, overrides, plots=True, completed=True)
+def run(path: Path, out: Path, cache: Path, plots: bool = False, **overrides) -> RunResult:
+    return run_file(path, out, overrides, plots=plots, completed=True)
 
 
 @pytest.fixture(scope="module")
 def decay(tmp_path_factory, fmu_cache) -> RunResult:
-    return run(DECAY, tmp_path_factory.mktemp("lever_decay"), fmu_cache)
+    return run(DECAY, tmp_path_factory.mktemp("lever_decay"), fmu_cache, plots=True)
 
 
 # -- the thesis's phase-scheduled model: the worked example ------------------------------------
@@ -192,7 +192,7 @@ def _rate_case(unit: int, multiple: int) -> dict[str, object]:
 
 
 def test_rate_sweep_case_unit4(tmp_path, fmu_cache) -> None:
-    r = run(RATE, tmp_path, fmu_cache, **_rate_case(4, 2))
+    r = run(RATE, tmp_path, fmu_cache, plots=True, **_rate_case(4, 2))
     assert r.value("table_i_unit") == 4
     assert r.value("load_multiple") == pytest.approx(2.0, rel=1e-12)
     # the thesis's computed unit curve at Table I's (C/omega0, K) = (0.050, 0.510), derived

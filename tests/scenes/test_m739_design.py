@@ -171,7 +171,9 @@ def test_designs_near_the_m739_run_in_agreement_or_are_refused(tmp_path, fmu_cac
         assert "design rule '" in str(exc)  # refused by a named rule, nothing else
         return
     assert violations(scene_design(scene)) == []
-    result = run_scene(scene, output_dir=tmp_path / "p", cache_dir=fmu_cache, show_progress=False)
+    result = run_scene(
+        scene, output_dir=tmp_path / "p", cache_dir=fmu_cache, show_progress=False, plots=False
+    )
     assert result.status == "completed", result.message
     assert result.accuracy["headline_error.turns_to_arm"] < 2e-4
     assert result.accuracy["event_count_difference"] == 0
