@@ -5,8 +5,8 @@ external resources) from what the project already states once: the component's d
 (which cite the source documents), its VARIABLES and PORTS tables, its regime names, and
 the FMU's record (``fmus.registry``): the wrapper script's description and default
 experiment, the requirements, and the example scenes that couple the FMU (named, never
-read: an FMU depends on no scene file).  The page tells a user of another tool (FMPy, libcosim, a C/C++ master)
-what the FMU models, how to couple it, and what its host needs.
+read: an FMU depends on no scene file).  The page tells a user of another tool (FMPy,
+libcosim, a C/C++ master) what the FMU models, how to couple it, and what its host needs.
 """
 
 from __future__ import annotations
