@@ -513,9 +513,10 @@ def _precision(args: argparse.Namespace) -> int:
     for master in dict.fromkeys(r.master for r in rows):
         line = f"  {master:22s} observed order {observed_order(rows, master):.2f}"
         ratios = [r.monolithic_ratio for r in rows if r.master == master]
-        ratios = [x for x in ratios if not math.isnan(x)]  # those in the turns-error window
+        ratios = [x for x in ratios if not math.isnan(x)]  # those in the error window
         if ratios:
-            line += f", x monolithic at the same turns error {min(ratios):.2f}..{max(ratios):.2f}"
+            word = rows[0].headline.word  # what the family's headline quantity counts
+            line += f", x monolithic at the same {word} error {min(ratios):.2f}..{max(ratios):.2f}"
         print(line)
     out = Path(rows[0].result.job.output_dir).parent if rows else args.output
     print(f"report in {out}/work_precision.md (.csv, .png)")

@@ -40,7 +40,7 @@ from orchestrator.progress import ProgressBar
 from orchestrator.provenance import source_commit
 from orchestrator.recorder import Recorder, StepStats
 from orchestrator.reference_cache import cached_reference
-from orchestrator.scenario import Scene
+from orchestrator.scene_model import Scene
 from orchestrator.scenes import ANALYSES, PLOTS, REFERENCES
 from orchestrator.scenes.family import Reference
 from orchestrator.signals import scene_signals

@@ -9,11 +9,9 @@ from __future__ import annotations
 
 import math
 import tomllib
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from components.base import Component
 from fmus.build import BuildError, build_fmu
 from fmus.ports import PortError, PortSide, join_ports
 from fmus.registry import FMU_RECORDS
@@ -23,7 +21,6 @@ from orchestrator.master_settings import (
     COMMON_KEYS,
     FixedStepSettings,
     SettingError,
-    Settings,
     read_options,
 )
 from orchestrator.masters.registry import (
@@ -35,7 +32,17 @@ from orchestrator.masters.registry import (
 )
 from orchestrator.model_info import ModelInfo, ModelInfoError, VariableInfo, model_info
 from orchestrator.regular_files import TOML_LIMIT, NotARegularFile, read_regular
-from orchestrator.scenes import ANALYSES, REFERENCES, family, shared_parameters
+from orchestrator.scene_model import (
+    Connection,
+    FmuSpec,
+    HeadlineSpec,
+    MasterSpec,
+    Scene,
+    StopCondition,
+    SweepSeries,
+    SweepSpec,
+)
+from orchestrator.scenes import ANALYSES, FAMILY_NAMES, REFERENCES, family, shared_parameters
 from orchestrator.scenes.family import Option, SharedParameter
 from orchestrator.signals import (
     Reader,
@@ -56,113 +63,11 @@ REDUCTIONS = ("final", "initial", "max", "min", "maxabs", "mean")
 #: More macro steps than this cannot finish in any sensible time: refused unless forced.
 MAX_STEPS = 1e8
 
-
-@dataclass(frozen=True)
-class FmuSpec:
-    instance: str
-    fmu_name: str  # our component's name in fmus.registry, or the FMU file's model name
-    path: Path  # the FMU file (ours: built and cached; another tool's: as the scene names it)
-    model: ModelInfo  # everything the orchestrator knows of the FMU, read from the file
-    parameters: dict[str, Any]  # SI values (int for Integer, bool for Boolean)
-    inputs: dict[str, Any]  # start values of inputs
-    component: str | None = None  # name in fmus.registry when the scene names one of ours
-    signals: dict[str, Signal] = field(default_factory=dict)  # inputs that vary in time
-
-
-@dataclass(frozen=True)
-class Connection:
-    source: tuple[str, str]  # (instance, output variable)
-    target: tuple[str, str]  # (instance, input variable)
-
-
 #: What each master's step key sets (its message when the scene gives none).
 STEP_MEANING = {
     "step": "macro step, e.g. '0.1 ms'",
     "first_step": "first step (and the step after a switch), e.g. '1 us'",
 }
-
-
-@dataclass(frozen=True)
-class MasterSpec:
-    algorithm: str
-    # The fixed macro step: master.step, else the first step the scene gives (what a
-    # fixed-step master, an exported archive's base step and crosscheck step at).
-    step: float
-    order: tuple[str, ...]
-    options: dict[str, Any] = field(default_factory=dict)  # as the scene wrote them (SI)
-    settings: Settings | None = None  # the algorithm's, defaults filled in
-
-    @property
-    def own_step(self) -> tuple[str, float]:
-        """The step key this master reads (step or first_step) and the step it takes."""
-        key = step_key(self.algorithm)
-        return key, getattr(self.settings, key, self.step)
-
-
-@dataclass(frozen=True)
-class HeadlineSpec:
-    signal: tuple[str, str]
-    reduce: str
-    unit: str
-
-
-@dataclass(frozen=True)
-class StopCondition:
-    """End the run when a signal first reaches a threshold (e.g. an S&A arming angle)."""
-
-    signal: tuple[str, str]
-    threshold: float  # in the signal's SI unit
-    rising: bool  # True: stop when the signal rises to the threshold; False: falls to it
-
-
-@dataclass(frozen=True)
-class SweepSeries:
-    label: str
-    overrides: dict[str, Any]  # dotted keys, as with --set
-
-
-@dataclass(frozen=True)
-class SweepSpec:
-    """One run per (series, value): the scene with ``parameter`` set to each value."""
-
-    parameter: str  # dotted key, e.g. "fmus.verge.parameters.center_distance"
-    values: tuple[Any, ...]  # as written (a unit string or a number)
-    si_values: tuple[float, ...]  # the same in SI, for tables and plots
-    unit: str  # SI unit of the swept value ("1" when plain)
-    label: str
-    quantities: tuple[str, ...]  # headline quantities tabulated and plotted; () = all
-    series: tuple[SweepSeries, ...]
-
-
-@dataclass(frozen=True)
-class Scene:
-    path: Path
-    name: str
-    description: str
-    start: float
-    stop: float
-    fmus: dict[str, FmuSpec]
-    connections: tuple[Connection, ...]
-    master: MasterSpec
-    record: tuple[tuple[str, str], ...]
-    record_every: int
-    output_dir: Path
-    headline: dict[str, HeadlineSpec]
-    family: str | None  # [report] family: the scene family whose analysis and plot run
-    report_options: dict[str, Any]  # [report.options], read by the family and the reference
-    reference: str | None = None
-    stop_when: StopCondition | None = None
-    error_bound: float = math.inf  # the error against the reference the scene claims
-    sweep: SweepSpec | None = None  # run by ``mechcosim sweep``; ``run`` ignores it
-    study: StudySpec | None = None  # run by ``mechcosim study``; ``run`` ignores it
-
-    def component_class(self, instance: str) -> type[Component]:
-        """The physics behind one of our FMUs (for scene analyses and references only:
-        masters, recorder and system know the FMUs through their files)."""
-        component = self.fmus[instance].component
-        if component is None:
-            raise ValueError(f"FMU instance {instance!r} is not one of this project's components")
-        return FMU_RECORDS[component].component_class
 
 
 def load_scene(
@@ -253,6 +158,7 @@ class _Loader:
     ) -> None:
         self.path, self.raw, self.cache_dir, self.force = path, raw, cache_dir, force
         self.span = (0.0, math.inf)  # the run's (start, stop), once [scene] is read
+        self.shared = shared_parameters(_families(raw))  # what the scene's families share
 
     def fail(self, key: str, message: str) -> ScenarioError:
         return ScenarioError(self.path, key, message)
@@ -458,12 +364,8 @@ class _Loader:
                 raise self.fail(f"{key}.fmu", str(exc)) from None
             params = self.values(entry.get("parameters", {}), f"{key}.parameters", model)
             for name, value in shared.items():
-                if _takes(component, model, shared_parameters().get(name)) or _designs(
-                    component, name
-                ):
-                    if name in params and not _takes(
-                        component, model, shared_parameters().get(name)
-                    ):
+                if _takes(component, model, self.shared.get(name)) or _designs(component, name):
+                    if name in params and not _takes(component, model, self.shared.get(name)):
                         raise self.fail(
                             f"{key}.parameters.{name}",
                             f"{name} is a quantity of the design, stated for the scene "
@@ -495,7 +397,7 @@ class _Loader:
         """A shared parameter is stated once, in [parameters], and some FMU takes it."""
         taken = {
             p.name: p
-            for p in shared_parameters().values()
+            for p in self.shared.values()
             for spec in fmus.values()
             if _takes(spec.component, spec.model, p)
         }
@@ -537,7 +439,7 @@ class _Loader:
         if len(parts) == 4 and parts[0] == "fmus" and parts[2] in ("parameters", "inputs"):
             return [(parts[1], parts[2], parts[3])]
         if len(parts) == 2 and parts[0] == "parameters":
-            shared = shared_parameters().get(parts[1])
+            shared = self.shared.get(parts[1])
             return [
                 (instance, "parameters", parts[1])
                 for instance, spec in fmus.items()
@@ -1001,6 +903,16 @@ class _Loader:
         if isinstance(value, bool) or not isinstance(value, int | float):
             raise self.fail(f"sweep.values[{k}]", f"expected a number, got {value!r}")
         return float(value)
+
+
+def _families(raw: dict[str, Any]) -> tuple[str, ...]:
+    """The families a scene names ([report] family and reference), before [report] is
+    checked: a misspelt or missing name shares nothing, and is refused with [report]."""
+    report = raw.get("report")
+    if not isinstance(report, dict):
+        return ()
+    named = (report.get("family"), report.get("reference"))
+    return tuple(dict.fromkeys(n for n in named if isinstance(n, str) and n in FAMILY_NAMES))
 
 
 def _designs(component: str | None, name: str) -> bool:

@@ -22,7 +22,8 @@ from typing import Any
 from orchestrator.errors import ScenarioError
 from orchestrator.model_info import ModelInfo, ModelInfoError, base_of_unit_name, model_info
 from orchestrator.regular_files import ARCHIVE_LIMIT, NotARegularFile, read_regular
-from orchestrator.scenario import Scene, read_toml, scene_from_table
+from orchestrator.scenario import read_toml, scene_from_table
+from orchestrator.scene_model import Scene
 from orchestrator.ssp_export import OSP, SSC, SSD, SSV
 
 #: Tables a companion TOML may give (the system itself comes from the archive).

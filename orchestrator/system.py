@@ -14,7 +14,7 @@ from typing import Any
 from orchestrator.errors import RunError
 from orchestrator.fmu_instance import FmuInstance
 from orchestrator.restore_check import RestoreCheck
-from orchestrator.scenario import Scene
+from orchestrator.scene_model import Scene
 from orchestrator.signals import scene_signals
 
 

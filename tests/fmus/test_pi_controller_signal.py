@@ -10,6 +10,7 @@ import foreign_fmus
 import numpy as np
 import pytest
 from fmpy import simulate_fmu
+from scene_run import run_file
 
 from orchestrator.errors import ScenarioError
 from orchestrator.run import run_scene
@@ -49,12 +50,7 @@ step = "1 ms"
 
 
 def run(path: Path, tmp_path: Path, algorithm: str):
-    result = run_scene(
-        load_scene(path, {"master.algorithm": algorithm}),
-        output_dir=tmp_path / algorithm,
-        show_progress=False,
-    )
-    return result
+    return run_file(path, tmp_path / algorithm, {"master.algorithm": algorithm})
 
 
 @pytest.mark.parametrize("algorithm", MASTERS)

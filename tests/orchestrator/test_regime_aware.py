@@ -7,6 +7,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from scene_run import run_file
 
 from orchestrator.run import run_scene
 from orchestrator.scenario import load_scene
@@ -16,10 +17,7 @@ STOP_AT_ONE_RADIAN = {"signal": "a.phi", "above": "1 rad"}
 
 
 def run(tmp_path, fmu_cache, **overrides):
-    scene = load_scene(SCENE, overrides)
-    return run_scene(
-        scene, output_dir=tmp_path / "run", cache_dir=fmu_cache, show_progress=False, plots=False
-    )
+    return run_file(SCENE, tmp_path / "run", overrides)
 
 
 def test_error_follows_the_tolerance_with_inputs_held_at_the_step_start(

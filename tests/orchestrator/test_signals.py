@@ -7,10 +7,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from scene_run import run_file
 
 from orchestrator.errors import ScenarioError
 from orchestrator.model_info import VariableInfo
-from orchestrator.run import run_scene
 from orchestrator.scenario import load_scene
 from orchestrator.signals import InputSignals, Reader, Signal, read_signal
 
@@ -42,10 +42,7 @@ def write(tmp_path: Path, text: str, name: str = "scene.toml") -> Path:
 
 
 def run(tmp_path: Path, path: Path, **overrides):
-    scene = load_scene(path, overrides)
-    result = run_scene(scene, output_dir=tmp_path / "out", show_progress=False)
-    assert result.status == "completed", result.message
-    return result
+    return run_file(path, tmp_path / "out", overrides, completed=True)
 
 
 def motion(signal: Signal, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -408,8 +405,7 @@ def test_fmpy_input_file_without_units_takes_the_declared_units(tmp_path: Path) 
         signals[name] = loaded.fmus["a"].signals["tau"]
     assert signals["fmpy"].times == signals["units"].times == (0.0, 0.001)
     assert signals["fmpy"].values == signals["units"].values == (0.0, 0.002)
-    result = run_scene(load_scene(tmp_path / "fmpy.toml"), tmp_path / "out", show_progress=False,
-                       plots=False, reference_cache=False)  # fmt: skip
+    result = run_file(tmp_path / "fmpy.toml", tmp_path / "out", reference=False)
     note = (
         "signal a.tau: a header without units (FMPy's input format): time in s, values in "
         "the input's declared unit N.m"

@@ -8,7 +8,7 @@ import shutil
 from pathlib import Path
 
 import pytest
-from test_study import scene_file
+from study_scene import scene_file
 
 from orchestrator.cli import main
 from orchestrator.errors import ScenarioError

@@ -7,31 +7,28 @@ import csv
 from pathlib import Path
 
 import pytest
+from scene_run import run_file
 
 from components.m739_data import LBF
-from orchestrator.run import run_scene
-from orchestrator.scenario import load_scene
 
 SCENE = Path(__file__).resolve().parents[2] / "scenarios" / "m739.toml"
 
 
-def run(tmp_path: Path, fmu_cache: Path, name: str, **overrides):
-    scene = load_scene(SCENE, overrides)
-    return run_scene(scene, output_dir=tmp_path / name, cache_dir=fmu_cache, show_progress=False)
+def run(tmp_path: Path, fmu_cache: Path, name: str, plots: bool = False, **overrides):
+    return run_file(SCENE, tmp_path / name, overrides, plots=plots)
 
 
 @pytest.fixture(scope="module")
 def default_run(tmp_path_factory, fmu_cache):
     """The scene as written: the single pass ("auto", the verge keeps a copy of the wheel)."""
-    return run(tmp_path_factory.mktemp("m739"), fmu_cache, "default")
+    return run(tmp_path_factory.mktemp("m739"), fmu_cache, "default", plots=True)
 
 
 @pytest.fixture(scope="module")
 def midpoint_run(tmp_path_factory, fmu_cache):
     """The scene under the regime-aware master's other scheme."""
-    return run(
-        tmp_path_factory.mktemp("m739"), fmu_cache, "midpoint", **{"master.input_hold": "midpoint"}
-    )
+    hold = {"master.input_hold": "midpoint"}
+    return run(tmp_path_factory.mktemp("m739"), fmu_cache, "midpoint", plots=True, **hold)
 
 
 #: The validations below hold for both schemes of the regime-aware master (the midpoint

@@ -12,7 +12,7 @@ import numpy as np
 
 from components.rotational import damped_oscillator_transition
 from orchestrator.plotting import column_unit, pyplot, recorded, save_figure, unit_label
-from orchestrator.scenario import Scene
+from orchestrator.scene_model import Scene
 from orchestrator.scenes.family import Reference
 from orchestrator.stop_condition import reference_crossing
 
