@@ -12,6 +12,10 @@ class ScenarioError(ValueError):
         self.path, self.key, self.message = str(path), key, message
         super().__init__(f"{path}: [{key}] {message}" if key else f"{path}: {message}")
 
+    def __reduce__(self):
+        # rebuilt from its three parts when a study's worker sends it back
+        return type(self), (self.path, self.key, self.message)
+
 
 class RunError(RuntimeError):
     """A run could not go on; what was recorded up to here is kept."""

@@ -162,10 +162,10 @@ def fixed_step_only(fmu: Path, target: Path) -> Path:
 
 @needs_cc
 def test_foreign_fmu_without_annotation_runs_under_the_plain_masters(tmp_path, foreign) -> None:
-    info = model_info(foreign / "TorsionBody.fmu")
+    info = model_info(foreign.torsion_body)
     assert not info.annotated and info.roles == {}
     for algorithm in ("jacobi", "gauss-seidel"):
-        path = write_scene(tmp_path, foreign_scene(str(foreign / "TorsionBody.fmu"), algorithm))
+        path = write_scene(tmp_path, foreign_scene(str(foreign.torsion_body), algorithm))
         r = run_scene(load_scene(path), output_dir=tmp_path / algorithm, show_progress=False)
         assert r.status == "completed", r.message
         exact = two_inertias_exact(np.array([0.2]), 2e-4, 1e-4, 2.0, 2e-3, 0.0, 10.0, 0.0, 0.0)
@@ -177,7 +177,7 @@ def test_foreign_fmu_without_annotation_runs_under_the_plain_masters(tmp_path, f
 def test_an_fmu_without_variable_steps_is_refused_where_a_master_varies_its_step(
     tmp_path, foreign
 ) -> None:
-    fmu = fixed_step_only(foreign / "TorsionBody.fmu", tmp_path / "TorsionBody.fmu")
+    fmu = fixed_step_only(foreign.torsion_body, tmp_path / "TorsionBody.fmu")
     # The regime-aware master sizes every step: it falls back to fixed-step Jacobi, on a grid.
     path = write_scene(tmp_path, foreign_scene(str(fmu), "regime-aware"))
     r = run_scene(load_scene(path), output_dir=tmp_path / "aware", show_progress=False)

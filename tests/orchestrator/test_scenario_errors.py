@@ -137,3 +137,11 @@ def test_the_former_report_analysis_key_names_report_family(tmp_path: Path) -> N
 def test_an_unknown_family_is_refused(tmp_path: Path) -> None:
     text = GOOD + '\n[report]\nfamily = "m793"\n'
     expect_error(write(tmp_path, text), "report.family", "unknown 'm793'", "'m739'")
+
+
+def test_a_scenario_error_survives_the_way_back_from_a_worker() -> None:
+    import pickle
+
+    error = ScenarioError("scene.toml", "fmus.b.parameters.J", "must be > 0, got -1e-05")
+    back = pickle.loads(pickle.dumps(error))
+    assert (type(back), str(back), back.key) == (ScenarioError, str(error), error.key)
