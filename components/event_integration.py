@@ -21,6 +21,7 @@ from dataclasses import dataclass, replace
 from typing import NamedTuple, Protocol
 
 from .base import ComponentError, Variable
+from .kernels import load_kernel
 
 
 class EventModel(Protocol):
@@ -493,3 +494,10 @@ def advance(
         if getattr(model, "halted", False):
             break
     return Advanced(y, t_first, t_event, n_events, h_next, steps, rejected)
+
+
+_KERNEL = load_kernel("m739_kernel")
+if _KERNEL is not None:  # the compiled twins (components.kernels): the same results
+    _KERNEL.use_step_type(_Step, _dp5_step)
+    _dp5_step = _KERNEL.dp5_step
+    dense_state = _KERNEL.dense_state
