@@ -35,7 +35,12 @@ from fmus.description import complete_description
 from fmus.documentation import render_documentation
 from fmus.example_scenes import ExampleSceneError
 from fmus.host_loader import LOADER_SOURCE, loader_binary, loader_plan, pack_loader
-from fmus.kernel_build import KERNEL_SOURCES, compiled_kernel, kernel_identity
+from fmus.kernel_build import (
+    KERNEL_SOURCES,
+    compiled_kernel,
+    default_cache_dir,
+    kernel_identity,
+)
 from fmus.registry import FMU_RECORDS, FmuRecord, RecordError
 
 FMUS_DIR = Path(__file__).resolve().parent
@@ -61,15 +66,6 @@ ZIP_DATE = (1980, 1, 1, 0, 0, 0)
 
 class BuildError(RuntimeError):
     """An FMU cannot be built (unknown name, unwritable cache, undeclared requirement)."""
-
-
-def default_cache_dir() -> Path:
-    """Where built FMUs live: $MECHCOSIM_FMU_CACHE, else the user cache directory."""
-    env = os.environ.get("MECHCOSIM_FMU_CACHE")
-    if env:
-        return Path(env)
-    base = Path(os.environ.get("XDG_CACHE_HOME", Path.home() / ".cache"))
-    return base / "mechcosim" / "fmus"
 
 
 def content_hash(record: FmuRecord) -> str:

@@ -41,6 +41,15 @@ FLAGS = (
 )
 
 
+def default_cache_dir() -> Path:
+    """Where built FMUs live: $MECHCOSIM_FMU_CACHE, else the user cache directory."""
+    env = os.environ.get("MECHCOSIM_FMU_CACHE")
+    if env:
+        return Path(env)
+    base = Path(os.environ.get("XDG_CACHE_HOME", Path.home() / ".cache"))
+    return base / "mechcosim" / "fmus"
+
+
 @dataclass(frozen=True)
 class KernelPlan:
     """How this environment builds kernels."""
@@ -126,8 +135,6 @@ def kernel_library(name: str, cache_dir: Path | None = None) -> Path | None:
     """The kernel's library in the FMU cache (``kernels/<name>-<hash>.so``), built if
     missing; None where it cannot be built."""
     if cache_dir is None:
-        from fmus.build import default_cache_dir
-
         cache_dir = default_cache_dir()
     target = Path(cache_dir) / "kernels" / f"{name}-{kernel_identity(name)[:16]}.so"
     if target.is_file():
