@@ -1232,3 +1232,12 @@ _KERNEL = load_kernel("m739_kernel")
 if _KERNEL is not None:  # the compiled twins (components.kernels): the same results
     contact_coefficients = _KERNEL.contact_coefficients
     VergeCore._coupled_terms = _KERNEL.coupled_terms
+    # the loop between events in C for these (event_integration.advance)
+    _KERNEL.use_classes(
+        verge_core=VergeCore,
+        held_train=HeldTrain,
+        moments=WithMoments,
+        until_first_event=UntilFirstEvent,
+        torque_at=VergeEscapement._torque_at,
+        verge_budget_spent=StepBudgetSpent,
+    )

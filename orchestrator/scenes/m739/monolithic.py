@@ -34,6 +34,7 @@ from components.gear_train import (
     TRAIN_STUCK,
     TrainPhysics,
 )
+from components.kernels import load_kernel
 from components.m739_data import LBF, M739, M739Data, rpm_to_rad_s
 from components.verge_escapement import (
     IND_CONTACT,
@@ -162,6 +163,11 @@ class VergeTrainMonolithic(VergeCore):
         elif not self.halted:
             self.record(y)
         return y
+
+
+_KERNEL = load_kernel("m739_kernel")
+if _KERNEL is not None:  # its integration between events runs compiled (components.kernels)
+    _KERNEL.use_classes(monolithic=VergeTrainMonolithic)
 
 
 def _indexing_code(indexing: int | str) -> int:
