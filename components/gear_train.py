@@ -556,4 +556,4 @@ class GearTrain(TrainComponent):
 _KERNEL = load_kernel("m739_kernel")
 if _KERNEL is not None:  # the compiled twin (components.kernels): the same results
     TrainPhysics._parts = _KERNEL.train_parts
-    _KERNEL.use_classes(live_train=TrainPhysics)
+    _KERNEL.use_classes(live_train=TrainPhysics, train_model=_TrainModel)

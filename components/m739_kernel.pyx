@@ -342,7 +342,7 @@ def dense_state(tuple dense, double theta):
 
 cdef dict CLASSES = dict.fromkeys((
     "verge_core", "monolithic", "held_train", "live_train", "moments", "until_first_event",
-    "torque_at", "verge_budget_spent",
+    "torque_at", "verge_budget_spent", "train_model", "ramped_load",
 ))
 cdef object COMPONENT_ERROR = RuntimeError
 cdef object BUDGET_SPENT = RuntimeError  # event_integration.StepBudgetSpent
@@ -438,128 +438,64 @@ cdef class _Dense:
         ]
 
 
-cdef class _VergeRun:
-    """One call of the compiled loop: the model's constants and mode as C values."""
+cdef class _Loop:
+    """event_integration.advance on C arrays for one model (a subclass gives its deriv,
+    indicators, accept, and how its mode is read from and written back to Python), with
+    the train physics' response parts (components.gear_train.TrainPhysics) for the models
+    that carry the live train."""
 
-    cdef object model, core, train
-    cdef bint monolithic, live, moments, has_budget, halted
-    cdef Py_ssize_t n_own, n, n_ind
-    cdef long long budget
-    # VergeConstants
-    cdef double a, b, c, mu1, mu_abs, om2, om_abs, beta3, gamma_pp, dn1, ip, a54
-    cdef double rho3, rho_p, rcp, mp, r4
-    cdef double alpha[2]
-    cdef double c1[2]
-    # VergeCore's mode
-    cdef int face, s4, s5, ipr_sign
-    cdef bint coupled, train_stuck, verge_stuck
-    cdef double phi_off, psic, phi_stop
-    # the train: held response or live physics
-    cdef int direction
-    cdef double j_ref, t_ref, c_load, j_phi, t_phi, t_w, phi0, w0
-    cdef int i1r_sign, s1, s2
+    cdef object model
+    cdef bint halted
+    cdef Py_ssize_t n, n_ind
+    # TrainPhysics: its mode and constants
+    cdef int direction, i1r_sign, s1, s2
     cdef double n1, n2, phi_lo, phi_hi
     cdef double kmu, kdn, a15c, a16, a31c, a42c, a43, a44c
     cdef double al1_in, span1, du1, u1_start, al2_in, span2, du2, u2_start
     cdef double rb1_cap, rb2_cap, d1, d2, phi1c, n31, n32, m1, rc1, r1, rho1
-    cdef double tr_om2, tr_om_abs, tr_mu_abs, i1, i2, i3, a35, t2, t3
-    # monolithic: the raised contact indicator and the force maxima
-    cdef bint has_shift
-    cdef int shift_face
-    cdef double shift_phi_off, shift
-    cdef double f23_max, f12_max, ff23_max, ff12_max, pn_max
-    # VergeCore.accept: the normal force's peak and its last two points
-    cdef double pn_peak
-    cdef int n_points
-    cdef double pts[2][2]
+    cdef double tr_om2, tr_om_abs, tr_mu_abs, i1, i2, i3, a35, t2, t3, i_stot
 
-    cdef int setup(self, object model, object core, bint moments, Py_ssize_t n_own) except -1:
-        self.model, self.core, self.train = model, core, core.train
-        self.monolithic = type(core) is CLASSES["monolithic"]
-        self.live = type(self.train) is CLASSES["live_train"]
-        self.moments = moments
-        self.n_own = n_own
-        self.n = n_own + (3 if moments else 0)
-        self.n_ind = 10 if self.live else 9
-        k = core.k
-        d = k.d
-        self.a, self.b, self.c = k.a, k.b, k.c
-        self.mu1, self.mu_abs = k.mu1, k.mu_abs
-        self.om2, self.om_abs = k.om2, k.om_abs
-        self.beta3, self.gamma_pp, self.dn1 = k.beta3, k.gamma_pp, k.dn1
-        self.ip, self.a54 = k.ip, k.a54
-        self.rho3, self.rho_p, self.rcp, self.mp, self.r4 = d.rho3, d.rho_p, d.rcp, d.mp, d.r4
-        self.alpha[1], self.alpha[0] = k.alpha[1], k.alpha[-1]
-        self.c1[1], self.c1[0] = k.c1[1], k.c1[-1]
-        self.phi_stop = core.phi_stop
-        if self.live:
-            tr = self.train
-            td = tr.d
-            self.al1_in, self.span1, self.du1, self.u1_start = (
-                tr.al1_in, tr.span1, tr.du1, tr.u1_start
-            )
-            self.al2_in, self.span2, self.du2, self.u2_start = (
-                tr.al2_in, tr.span2, tr.du2, tr.u2_start
-            )
-            self.rb1_cap, self.rb2_cap, self.d1, self.d2 = td.rb1_cap, td.rb2_cap, tr.d1, tr.d2
-            self.phi1c, self.n31, self.n32 = td.phi1c, tr.n31, tr.n32
-            self.m1, self.rc1, self.r1, self.rho1 = td.m1, td.rc1, td.r1, td.rho1
-            self.tr_om2, self.tr_om_abs, self.tr_mu_abs = tr.om2, tr.om_abs, tr.mu_abs
-            self.i1, self.i2, self.i3 = td.i1, td.i2, td.i3
-            self.a35, self.t2, self.t3 = tr.a35, tr.t2, tr.t3
-        self.load()
+    cdef int deriv(self, double* y, double* out) except -1:
+        return 0
+
+    cdef int indicators(self, double* y, double* g) except -1:
+        return 0
+
+    cdef int accept(self, double* y, double t) except -1:
         return 0
 
     cdef int load(self) except -1:
-        """The mode, as the Python code left it."""
-        core, tr = self.core, self.train
-        self.face, self.s4, self.s5, self.ipr_sign = core.face, core.s4, core.s5, core.ipr_sign
-        self.coupled, self.train_stuck = core.coupled, core.train_stuck
-        self.verge_stuck = core.verge_stuck
-        self.phi_off, self.psic = core.phi_off, core.psic
-        self.direction = tr.direction
-        budget = core.budget
-        self.has_budget = budget is not None
-        if self.has_budget:
-            self.budget = budget
-        if self.live:
-            self.i1r_sign, self.s1, self.s2 = tr.i1r_sign, tr.s1, tr.s2
-            self.n1, self.n2 = tr.n1, tr.n2
-            self.phi_lo, self.phi_hi = tr.phi_lo, tr.phi_hi
-            (self.kmu, self.kdn, self.a15c, self.a16, self.a31c, self.a42c, self.a43,
-             self.a44c) = tr._k[:8]
-        else:
-            self.j_ref, self.t_ref, self.c_load = tr.j_ref, tr.t_ref, tr.c_load
-            self.j_phi, self.t_phi, self.t_w = tr.j_phi, tr.t_phi, tr.t_w
-            self.phi0, self.w0 = tr.phi0, tr.w0
-        if self.monolithic:
-            shift = core.gap_shift
-            self.has_shift = shift is not None
-            if self.has_shift:
-                self.shift_face, self.shift_phi_off, self.shift = shift
-            self.f23_max, self.f12_max, self.pn_max = core.f23_max, core.f12_max, core.pn_max
-            self.ff23_max, self.ff12_max = core.ff23_max, core.ff12_max
-        else:
-            self.pn_peak = core.pn_peak
-            points = core.pn_points
-            self.n_points = len(points)
-            for i in range(self.n_points):
-                self.pts[i][0], self.pts[i][1] = points[i]
-        self.halted = bool(getattr(self.model, "halted", False))
         return 0
 
     cdef int store(self) except -1:
-        """What the loop changed, for the Python code."""
-        core = self.core
-        core.budget = self.budget if self.has_budget else None
-        if self.monolithic:
-            core.f23_max, core.f12_max, core.pn_max = self.f23_max, self.f12_max, self.pn_max
-            core.ff23_max, core.ff12_max = self.ff23_max, self.ff12_max
-        else:
-            core.pn_peak = self.pn_peak
-            core.pn_points = tuple(
-                [(self.pts[i][0], self.pts[i][1]) for i in range(self.n_points)]
-            )
+        return 0
+
+    cdef int setup_live(self, object tr) except -1:
+        """The train physics' constants."""
+        td = tr.d
+        self.al1_in, self.span1, self.du1, self.u1_start = (
+            tr.al1_in, tr.span1, tr.du1, tr.u1_start
+        )
+        self.al2_in, self.span2, self.du2, self.u2_start = (
+            tr.al2_in, tr.span2, tr.du2, tr.u2_start
+        )
+        self.rb1_cap, self.rb2_cap, self.d1, self.d2 = td.rb1_cap, td.rb2_cap, tr.d1, tr.d2
+        self.phi1c, self.n31, self.n32 = td.phi1c, tr.n31, tr.n32
+        self.m1, self.rc1, self.r1, self.rho1 = td.m1, td.rc1, td.r1, td.rho1
+        self.tr_om2, self.tr_om_abs, self.tr_mu_abs = tr.om2, tr.om_abs, tr.mu_abs
+        self.i1, self.i2, self.i3 = td.i1, td.i2, td.i3
+        self.a35, self.t2, self.t3 = tr.a35, tr.t2, tr.t3
+        self.i_stot = tr.i_stot
+        return 0
+
+    cdef int load_live(self, object tr) except -1:
+        """The train physics' mode."""
+        self.direction = tr.direction
+        self.i1r_sign, self.s1, self.s2 = tr.i1r_sign, tr.s1, tr.s2
+        self.n1, self.n2 = tr.n1, tr.n2
+        self.phi_lo, self.phi_hi = tr.phi_lo, tr.phi_hi
+        (self.kmu, self.kdn, self.a15c, self.a16, self.a31c, self.a42c, self.a43,
+         self.a44c) = tr._k[:8]
         return 0
 
     # -- the train --------------------------------------------------------------------
@@ -606,263 +542,6 @@ cdef class _VergeRun:
         o[4] = a42
         o[5] = self.a43
         o[6] = a44
-        return 0
-
-    cdef int response(self, double phi, double phi_dot, double* o) except -1:
-        """(J_ref, T_ref, c_load) of the train."""
-        cdef double p[7]
-        cdef double dp
-        if self.live:
-            self.parts(phi, phi_dot, p)
-            o[0], o[1], o[2] = p[0], p[1], 1.0
-        else:
-            dp = phi - self.phi0
-            o[0] = self.j_ref + self.j_phi * dp
-            o[1] = self.t_ref + self.t_phi * dp + self.t_w * (phi_dot - self.w0)
-            o[2] = self.c_load
-        return 0
-
-    # -- the verge --------------------------------------------------------------------
-    cdef int pivot(self, int s5, double psi_c, double* o) except -1:
-        """VergeConstants.pivot: A19, A20, A22 (independent of psi_c for r_cp = 0, where
-        the Python code remembers its first values)."""
-        cdef double mu1 = self.mu1, dn1 = self.dn1, g = self.gamma_pp
-        cdef double mp = self.mp, r4 = self.r4, rcp = self.rcp, rho_p = self.rho_p
-        cdef double sp = 0.0, cp = 0.0, a2, a6, a3, a4
-        if rcp != 0.0:
-            sp, cp = _sin(psi_c), _cos(psi_c)
-        a2 = fabs(mp * (r4 * (_sin(g) - mu1 * s5 * _cos(g)) + rcp * (sp - mu1 * s5 * cp)))
-        a6 = fabs(mp * (-r4 * (_cos(g) + mu1 * s5 * _sin(g)) - rcp * (cp + mu1 * s5 * sp)))
-        a3 = fabs(mp * rcp * (sp - mu1 * s5 * cp)) / dn1
-        a4 = fabs(mp * rcp * (cp + mu1 * s5 * sp)) / dn1
-        o[0] = rho_p * mu1 * s5 * (a2 + a6) / dn1
-        o[1] = rho_p * mu1 * (a3 + a4)
-        o[2] = rho_p * mu1 * (a4 + a3)
-        return 0
-
-    cdef double ipr(self, double psi) except? -2.0:
-        cdef double pv[3]
-        cdef double v
-        self.pivot(1, psi + self.psic, pv)
-        v = self.ip + self.ipr_sign * pv[2]
-        return v if v > 0.0 else 0.0
-
-    cdef int coupled_terms(self, double y0, double w, double* o) except -1:
-        """VergeCore._coupled_terms into o[0:13]."""
-        cdef double kn[7]
-        cdef double pv[3]
-        cdef double tr[3]
-        cdef int face = self.face, fi = _fidx(face)
-        cdef double phi_l = y0 + self.phi_off
-        cdef double alpha = self.alpha[fi]
-        cdef double psi, g, u, v, a1p, b1p, d1p, a19, a20, a21, a17, a18, ipr, j, t, c
-        cdef double a52, cent, psi_d, n, den, acc, psi_dd, pn, vst
-        cdef int s4 = self.s4, s5 = self.s5
-        cdef double mu1, mu, spa, cpa, chi, sc, cc, dn, c1p, a1, a5, a9, a12
-        _kinem_c(phi_l, alpha, self.a, self.b, self.c, kn)
-        psi, g, u, v, a1p, b1p, d1p = kn[0], kn[1], kn[2], kn[3], kn[4], kn[5], kn[6]
-        self.pivot(s5, psi + self.psic, pv)
-        a19, a20 = pv[0], pv[1]
-        a21 = s5 * a20
-        # contact_coefficients
-        mu1 = self.mu1
-        mu = self.mu_abs * self.direction
-        spa, cpa = _sin(psi + alpha), _cos(psi + alpha)
-        chi = psi + alpha + self.beta3
-        sc, cc = _sin(chi), _cos(chi)
-        dn = 1.0 + mu * mu
-        c1p = self.c1[fi]
-        if face == 1:
-            a1 = fabs(-mu1 * (s4 + s5) * spa - (1.0 - s4 * s5 * mu1 * mu1) * cpa) / self.dn1
-            a5 = fabs(mu1 * (s4 + s5) * cpa + (1.0 - s4 * s5 * mu1 * mu1) * spa) / self.dn1
-            a9 = fabs((mu1 * s4 + mu) * sc + (1.0 - mu * mu1 * s4) * cc) / dn
-            a12 = fabs((1.0 - mu * mu1 * s4) * sc - (s4 * mu1 + mu) * cc) / dn
-            a17 = a1p - mu1 * s4 * b1p + mu * self.rho3 * (a9 + a12)
-            a18 = d1p - c1p * mu1 * s4 - self.rho_p * mu1 * s5 * (a1 + a5)
-        else:
-            a1 = fabs(mu1 * (s5 - s4) * spa + (1.0 + mu1 * mu1 * s4 * s5) * cpa) / self.dn1
-            a5 = fabs(mu1 * (s5 - s4) * cpa - (1.0 + mu1 * mu1 * s4 * s5) * spa) / self.dn1
-            a9 = fabs((mu1 * s4 - mu) * sc - (1.0 + s4 * mu * mu1) * cc) / dn
-            a12 = fabs(-(1.0 + mu * mu1 * s4) * sc + (mu - mu1 * s4) * cc) / dn
-            a17 = -a1p - mu1 * s4 * b1p + mu * self.rho3 * (a9 + a12)
-            a18 = -(d1p + c1p * mu1 * s4 + self.rho_p * mu1 * s5 * (a1 + a5))
-        ipr = self.ipr(psi)
-        self.response(y0, w, tr)
-        j, t, c = tr[0], tr[1], tr[2]
-        a52 = 2.0 * self.om_abs * a20
-        cent = self.a54 * _sin(self.gamma_pp - psi - self.psic)
-        psi_d = u * w
-        n = (ipr * v + a21 * u * u) * w * w + a52 * psi_d + self.om2 * a19 - cent
-        den = j * a18 + c * a17 * ipr * u
-        if self.train_stuck:
-            acc = 0.0
-        else:
-            acc = (a18 * t - c * a17 * n) / den
-        psi_dd = u * acc + v * w * w
-        pn = (ipr * psi_dd + a21 * psi_d * psi_d + a52 * psi_d + self.om2 * a19 - cent) / a18
-        vst = -(w * self.b * _sin(phi_l - psi - alpha) + psi_d * self.c * _sin(alpha))
-        o[0] = acc
-        o[1] = psi
-        o[2] = psi_d
-        o[3] = psi_dd
-        o[4] = pn
-        o[5] = -a17 * pn
-        o[6] = g
-        o[7] = u
-        o[8] = vst
-        o[9] = den / a18
-        o[10] = cent
-        o[11] = -a17 * n / a18
-        o[12] = a17 * ipr * u / a18
-        return 0
-
-    cdef int free_terms(self, double* y, double* o) except -1:
-        """VergeCore.free_terms: phi_dd, psi_dd, cent."""
-        cdef double pv[3]
-        cdef double tr[3]
-        cdef double psi = y[2], psi_d = y[3], cent, psi_dd, a52
-        cent = self.a54 * _sin(self.gamma_pp - psi - self.psic)
-        if self.verge_stuck:
-            psi_dd = 0.0
-        else:
-            self.pivot(self.s5, psi + self.psic, pv)
-            a52 = 2.0 * self.om_abs * pv[1]
-            psi_dd = (
-                -self.s5 * pv[1] * psi_d * psi_d - a52 * psi_d - self.om2 * pv[0] + cent
-            ) / self.ipr(psi)
-        if self.train_stuck:
-            o[0] = 0.0
-        else:
-            self.response(y[0], y[1], tr)
-            o[0] = tr[1] / tr[0]
-        o[1] = psi_dd
-        o[2] = cent
-        return 0
-
-    cdef int deriv(self, double* y, double* out) except -1:
-        """VergeCore.deriv (and WithMoments' appended states)."""
-        cdef double o[13]
-        cdef double w = y[1], v = 0.0
-        if self.coupled:
-            self.coupled_terms(y[0], w, o)
-            out[0] = w
-            out[1] = o[0]
-            out[2] = o[2]
-            out[3] = o[3]
-            out[4] = -o[5] * w - self.ip * o[2] * o[3] + o[10] * o[2]
-            v = o[5]
-        else:
-            self.free_terms(y, o)
-            out[0] = w
-            out[1] = o[0]
-            out[2] = y[3]
-            out[3] = o[1]
-            out[4] = -self.ip * y[3] * o[1] + o[2] * y[3]
-        if self.moments:
-            out[5] = 1.0
-            out[6] = v
-            out[7] = y[5] * v
-        return 0
-
-    cdef int indicators(self, double* y, double* g) except -1:
-        """VergeCore.indicators (with the monolithic model's raised contact indicator)."""
-        cdef double o[13]
-        cdef int sigma = self.face, fi = _fidx(sigma)
-        cdef double hi = 1.0, lo = 1.0, wheel, stop, phi_l, psi, alpha, arg, f, gp, acc, psi_dd
-        if self.has_budget:
-            self.budget -= 1
-            if self.budget < 0:
-                raise CLASSES["verge_budget_spent"]("internal step budget spent")
-        if self.live:
-            hi, lo = self.phi_hi - y[0], y[0] - self.phi_lo
-        wheel = 1.0 if self.train_stuck else self.direction * y[1]
-        stop = self.phi_stop - y[0]
-        if self.coupled:
-            self.coupled_terms(y[0], y[1], o)
-            g[0] = sigma * o[6]
-            g[1] = o[4]
-            g[2] = self.s4 * o[8]
-            g[3] = self.s5 * o[2]
-            acc, psi_dd = o[0], o[3]
-        else:
-            phi_l = y[0] + self.phi_off
-            psi = y[2]
-            alpha = self.alpha[fi]
-            arg = phi_l - psi - alpha
-            f = self.a * _sin(psi + alpha) - self.b * _sin(arg) - self.c * _sin(alpha)
-            gp = self.a * _cos(psi + alpha) + self.b * _cos(arg) - self.c * _cos(alpha)
-            g[0] = sigma * gp
-            g[1] = sigma * f
-            g[2] = 1.0
-            g[3] = 1.0 if self.verge_stuck else self.s5 * y[3]
-            self.free_terms(y, o)
-            acc, psi_dd = o[0], o[1]
-            if (
-                self.has_shift and self.shift_face == self.face
-                and self.shift_phi_off == self.phi_off
-            ):
-                g[1] = g[1] + self.shift
-        g[4] = wheel
-        g[5] = hi
-        g[6] = lo
-        g[7] = stop
-        g[8] = self.ipr_sign * self.s5 * psi_dd
-        if self.live:
-            g[9] = self.i1r_sign * self.direction * acc
-        return 0
-
-    cdef int accept(self, double* y, double t) except -1:
-        """VergeCore.accept (the normal force's peak), or the monolithic model's record
-        (its force maxima; a self-locking point goes to the Python code, which halts)."""
-        cdef double o[13]
-        cdef double p[7]
-        cdef double pn, peak, acc, f12, f23
-        if self.monolithic:
-            if self.coupled:
-                self.coupled_terms(y[0], y[1], o)
-                acc, pn = o[0], o[4]
-                self.parts(y[0], y[1], p)
-                if o[9] <= 0.0 or p[0] <= 0.0:
-                    self.store()
-                    self.core.accept([y[i] for i in range(self.n)], t)
-                    self.load()
-                    return 0
-            else:
-                self.free_terms(y, o)
-                acc = o[0]
-                self.parts(y[0], y[1], p)
-            f23 = p[2] + p[3] * acc
-            f12 = (f23 * p[6] + self.t2 * p[5] - self.i2 * self.n32 * acc) / p[4]
-            if self.coupled:
-                self.f23_max = f23 if f23 > self.f23_max else self.f23_max
-                self.f12_max = f12 if f12 > self.f12_max else self.f12_max
-                self.pn_max = pn if pn > self.pn_max else self.pn_max
-            else:
-                self.ff23_max = f23 if f23 > self.ff23_max else self.ff23_max
-                self.ff12_max = f12 if f12 > self.ff12_max else self.ff12_max
-            return 0
-        if not self.coupled:
-            self.n_points = 0
-            return 0
-        self.coupled_terms(y[0], y[1], o)
-        pn = o[4]
-        t += self.core.t_base
-        if self.n_points == 2:
-            peak = _vertex_c(
-                self.pts[0][0], self.pts[0][1], self.pts[1][0], self.pts[1][1], t, pn
-            )
-            peak = peak if peak > pn else pn
-        else:
-            peak = pn
-        self.pn_peak = peak if peak > self.pn_peak else self.pn_peak
-        if self.n_points == 0:
-            self.n_points = 1
-        else:
-            if self.n_points == 2:
-                self.pts[0][0], self.pts[0][1] = self.pts[1][0], self.pts[1][1]
-            self.n_points = 2
-        self.pts[self.n_points - 1][0] = t
-        self.pts[self.n_points - 1][1] = pn
         return 0
 
     # -- one Dormand-Prince step ------------------------------------------------------
@@ -1139,13 +818,491 @@ cdef class _VergeRun:
         return self.pylist(Y), t_first, t_event, n_events, h_next, steps, rejected
 
 
+cdef class _VergeRun(_Loop):
+    """One call of the compiled loop: the model's constants and mode as C values."""
+
+    cdef object core, train
+    cdef bint monolithic, live, moments, has_budget
+    cdef Py_ssize_t n_own
+    cdef long long budget
+    # VergeConstants
+    cdef double a, b, c, mu1, mu_abs, om2, om_abs, beta3, gamma_pp, dn1, ip, a54
+    cdef double rho3, rho_p, rcp, mp, r4
+    cdef double alpha[2]
+    cdef double c1[2]
+    # VergeCore's mode
+    cdef int face, s4, s5, ipr_sign
+    cdef bint coupled, train_stuck, verge_stuck
+    cdef double phi_off, psic, phi_stop
+    # the train: held response or live physics
+    cdef double j_ref, t_ref, c_load, j_phi, t_phi, t_w, phi0, w0
+    # monolithic: the raised contact indicator and the force maxima
+    cdef bint has_shift
+    cdef int shift_face
+    cdef double shift_phi_off, shift
+    cdef double f23_max, f12_max, ff23_max, ff12_max, pn_max
+    # VergeCore.accept: the normal force's peak and its last two points
+    cdef double pn_peak
+    cdef int n_points
+    cdef double pts[2][2]
+
+    cdef int setup(self, object model, object core, bint moments, Py_ssize_t n_own) except -1:
+        self.model, self.core, self.train = model, core, core.train
+        self.monolithic = type(core) is CLASSES["monolithic"]
+        self.live = type(self.train) is CLASSES["live_train"]
+        self.moments = moments
+        self.n_own = n_own
+        self.n = n_own + (3 if moments else 0)
+        self.n_ind = 10 if self.live else 9
+        k = core.k
+        d = k.d
+        self.a, self.b, self.c = k.a, k.b, k.c
+        self.mu1, self.mu_abs = k.mu1, k.mu_abs
+        self.om2, self.om_abs = k.om2, k.om_abs
+        self.beta3, self.gamma_pp, self.dn1 = k.beta3, k.gamma_pp, k.dn1
+        self.ip, self.a54 = k.ip, k.a54
+        self.rho3, self.rho_p, self.rcp, self.mp, self.r4 = d.rho3, d.rho_p, d.rcp, d.mp, d.r4
+        self.alpha[1], self.alpha[0] = k.alpha[1], k.alpha[-1]
+        self.c1[1], self.c1[0] = k.c1[1], k.c1[-1]
+        self.phi_stop = core.phi_stop
+        if self.live:
+            self.setup_live(self.train)
+        self.load()
+        return 0
+
+    cdef int load(self) except -1:
+        """The mode, as the Python code left it."""
+        core, tr = self.core, self.train
+        self.face, self.s4, self.s5, self.ipr_sign = core.face, core.s4, core.s5, core.ipr_sign
+        self.coupled, self.train_stuck = core.coupled, core.train_stuck
+        self.verge_stuck = core.verge_stuck
+        self.phi_off, self.psic = core.phi_off, core.psic
+        self.direction = tr.direction
+        budget = core.budget
+        self.has_budget = budget is not None
+        if self.has_budget:
+            self.budget = budget
+        if self.live:
+            self.load_live(tr)
+        else:
+            self.j_ref, self.t_ref, self.c_load = tr.j_ref, tr.t_ref, tr.c_load
+            self.j_phi, self.t_phi, self.t_w = tr.j_phi, tr.t_phi, tr.t_w
+            self.phi0, self.w0 = tr.phi0, tr.w0
+        if self.monolithic:
+            shift = core.gap_shift
+            self.has_shift = shift is not None
+            if self.has_shift:
+                self.shift_face, self.shift_phi_off, self.shift = shift
+            self.f23_max, self.f12_max, self.pn_max = core.f23_max, core.f12_max, core.pn_max
+            self.ff23_max, self.ff12_max = core.ff23_max, core.ff12_max
+        else:
+            self.pn_peak = core.pn_peak
+            points = core.pn_points
+            self.n_points = len(points)
+            for i in range(self.n_points):
+                self.pts[i][0], self.pts[i][1] = points[i]
+        self.halted = bool(getattr(self.model, "halted", False))
+        return 0
+
+    cdef int store(self) except -1:
+        """What the loop changed, for the Python code."""
+        core = self.core
+        core.budget = self.budget if self.has_budget else None
+        if self.monolithic:
+            core.f23_max, core.f12_max, core.pn_max = self.f23_max, self.f12_max, self.pn_max
+            core.ff23_max, core.ff12_max = self.ff23_max, self.ff12_max
+        else:
+            core.pn_peak = self.pn_peak
+            core.pn_points = tuple(
+                [(self.pts[i][0], self.pts[i][1]) for i in range(self.n_points)]
+            )
+        return 0
+
+    cdef int response(self, double phi, double phi_dot, double* o) except -1:
+        """(J_ref, T_ref, c_load) of the train."""
+        cdef double p[7]
+        cdef double dp
+        if self.live:
+            self.parts(phi, phi_dot, p)
+            o[0], o[1], o[2] = p[0], p[1], 1.0
+        else:
+            dp = phi - self.phi0
+            o[0] = self.j_ref + self.j_phi * dp
+            o[1] = self.t_ref + self.t_phi * dp + self.t_w * (phi_dot - self.w0)
+            o[2] = self.c_load
+        return 0
+
+    # -- the verge --------------------------------------------------------------------
+    cdef int pivot(self, int s5, double psi_c, double* o) except -1:
+        """VergeConstants.pivot: A19, A20, A22 (independent of psi_c for r_cp = 0, where
+        the Python code remembers its first values)."""
+        cdef double mu1 = self.mu1, dn1 = self.dn1, g = self.gamma_pp
+        cdef double mp = self.mp, r4 = self.r4, rcp = self.rcp, rho_p = self.rho_p
+        cdef double sp = 0.0, cp = 0.0, a2, a6, a3, a4
+        if rcp != 0.0:
+            sp, cp = _sin(psi_c), _cos(psi_c)
+        a2 = fabs(mp * (r4 * (_sin(g) - mu1 * s5 * _cos(g)) + rcp * (sp - mu1 * s5 * cp)))
+        a6 = fabs(mp * (-r4 * (_cos(g) + mu1 * s5 * _sin(g)) - rcp * (cp + mu1 * s5 * sp)))
+        a3 = fabs(mp * rcp * (sp - mu1 * s5 * cp)) / dn1
+        a4 = fabs(mp * rcp * (cp + mu1 * s5 * sp)) / dn1
+        o[0] = rho_p * mu1 * s5 * (a2 + a6) / dn1
+        o[1] = rho_p * mu1 * (a3 + a4)
+        o[2] = rho_p * mu1 * (a4 + a3)
+        return 0
+
+    cdef double ipr(self, double psi) except? -2.0:
+        cdef double pv[3]
+        cdef double v
+        self.pivot(1, psi + self.psic, pv)
+        v = self.ip + self.ipr_sign * pv[2]
+        return v if v > 0.0 else 0.0
+
+    cdef int coupled_terms(self, double y0, double w, double* o) except -1:
+        """VergeCore._coupled_terms into o[0:13]."""
+        cdef double kn[7]
+        cdef double pv[3]
+        cdef double tr[3]
+        cdef int face = self.face, fi = _fidx(face)
+        cdef double phi_l = y0 + self.phi_off
+        cdef double alpha = self.alpha[fi]
+        cdef double psi, g, u, v, a1p, b1p, d1p, a19, a20, a21, a17, a18, ipr, j, t, c
+        cdef double a52, cent, psi_d, n, den, acc, psi_dd, pn, vst
+        cdef int s4 = self.s4, s5 = self.s5
+        cdef double mu1, mu, spa, cpa, chi, sc, cc, dn, c1p, a1, a5, a9, a12
+        _kinem_c(phi_l, alpha, self.a, self.b, self.c, kn)
+        psi, g, u, v, a1p, b1p, d1p = kn[0], kn[1], kn[2], kn[3], kn[4], kn[5], kn[6]
+        self.pivot(s5, psi + self.psic, pv)
+        a19, a20 = pv[0], pv[1]
+        a21 = s5 * a20
+        # contact_coefficients
+        mu1 = self.mu1
+        mu = self.mu_abs * self.direction
+        spa, cpa = _sin(psi + alpha), _cos(psi + alpha)
+        chi = psi + alpha + self.beta3
+        sc, cc = _sin(chi), _cos(chi)
+        dn = 1.0 + mu * mu
+        c1p = self.c1[fi]
+        if face == 1:
+            a1 = fabs(-mu1 * (s4 + s5) * spa - (1.0 - s4 * s5 * mu1 * mu1) * cpa) / self.dn1
+            a5 = fabs(mu1 * (s4 + s5) * cpa + (1.0 - s4 * s5 * mu1 * mu1) * spa) / self.dn1
+            a9 = fabs((mu1 * s4 + mu) * sc + (1.0 - mu * mu1 * s4) * cc) / dn
+            a12 = fabs((1.0 - mu * mu1 * s4) * sc - (s4 * mu1 + mu) * cc) / dn
+            a17 = a1p - mu1 * s4 * b1p + mu * self.rho3 * (a9 + a12)
+            a18 = d1p - c1p * mu1 * s4 - self.rho_p * mu1 * s5 * (a1 + a5)
+        else:
+            a1 = fabs(mu1 * (s5 - s4) * spa + (1.0 + mu1 * mu1 * s4 * s5) * cpa) / self.dn1
+            a5 = fabs(mu1 * (s5 - s4) * cpa - (1.0 + mu1 * mu1 * s4 * s5) * spa) / self.dn1
+            a9 = fabs((mu1 * s4 - mu) * sc - (1.0 + s4 * mu * mu1) * cc) / dn
+            a12 = fabs(-(1.0 + mu * mu1 * s4) * sc + (mu - mu1 * s4) * cc) / dn
+            a17 = -a1p - mu1 * s4 * b1p + mu * self.rho3 * (a9 + a12)
+            a18 = -(d1p + c1p * mu1 * s4 + self.rho_p * mu1 * s5 * (a1 + a5))
+        ipr = self.ipr(psi)
+        self.response(y0, w, tr)
+        j, t, c = tr[0], tr[1], tr[2]
+        a52 = 2.0 * self.om_abs * a20
+        cent = self.a54 * _sin(self.gamma_pp - psi - self.psic)
+        psi_d = u * w
+        n = (ipr * v + a21 * u * u) * w * w + a52 * psi_d + self.om2 * a19 - cent
+        den = j * a18 + c * a17 * ipr * u
+        if self.train_stuck:
+            acc = 0.0
+        else:
+            acc = (a18 * t - c * a17 * n) / den
+        psi_dd = u * acc + v * w * w
+        pn = (ipr * psi_dd + a21 * psi_d * psi_d + a52 * psi_d + self.om2 * a19 - cent) / a18
+        vst = -(w * self.b * _sin(phi_l - psi - alpha) + psi_d * self.c * _sin(alpha))
+        o[0] = acc
+        o[1] = psi
+        o[2] = psi_d
+        o[3] = psi_dd
+        o[4] = pn
+        o[5] = -a17 * pn
+        o[6] = g
+        o[7] = u
+        o[8] = vst
+        o[9] = den / a18
+        o[10] = cent
+        o[11] = -a17 * n / a18
+        o[12] = a17 * ipr * u / a18
+        return 0
+
+    cdef int free_terms(self, double* y, double* o) except -1:
+        """VergeCore.free_terms: phi_dd, psi_dd, cent."""
+        cdef double pv[3]
+        cdef double tr[3]
+        cdef double psi = y[2], psi_d = y[3], cent, psi_dd, a52
+        cent = self.a54 * _sin(self.gamma_pp - psi - self.psic)
+        if self.verge_stuck:
+            psi_dd = 0.0
+        else:
+            self.pivot(self.s5, psi + self.psic, pv)
+            a52 = 2.0 * self.om_abs * pv[1]
+            psi_dd = (
+                -self.s5 * pv[1] * psi_d * psi_d - a52 * psi_d - self.om2 * pv[0] + cent
+            ) / self.ipr(psi)
+        if self.train_stuck:
+            o[0] = 0.0
+        else:
+            self.response(y[0], y[1], tr)
+            o[0] = tr[1] / tr[0]
+        o[1] = psi_dd
+        o[2] = cent
+        return 0
+
+    cdef int deriv(self, double* y, double* out) except -1:
+        """VergeCore.deriv (and WithMoments' appended states)."""
+        cdef double o[13]
+        cdef double w = y[1], v = 0.0
+        if self.coupled:
+            self.coupled_terms(y[0], w, o)
+            out[0] = w
+            out[1] = o[0]
+            out[2] = o[2]
+            out[3] = o[3]
+            out[4] = -o[5] * w - self.ip * o[2] * o[3] + o[10] * o[2]
+            v = o[5]
+        else:
+            self.free_terms(y, o)
+            out[0] = w
+            out[1] = o[0]
+            out[2] = y[3]
+            out[3] = o[1]
+            out[4] = -self.ip * y[3] * o[1] + o[2] * y[3]
+        if self.moments:
+            out[5] = 1.0
+            out[6] = v
+            out[7] = y[5] * v
+        return 0
+
+    cdef int indicators(self, double* y, double* g) except -1:
+        """VergeCore.indicators (with the monolithic model's raised contact indicator)."""
+        cdef double o[13]
+        cdef int sigma = self.face, fi = _fidx(sigma)
+        cdef double hi = 1.0, lo = 1.0, wheel, stop, phi_l, psi, alpha, arg, f, gp, acc, psi_dd
+        if self.has_budget:
+            self.budget -= 1
+            if self.budget < 0:
+                raise CLASSES["verge_budget_spent"]("internal step budget spent")
+        if self.live:
+            hi, lo = self.phi_hi - y[0], y[0] - self.phi_lo
+        wheel = 1.0 if self.train_stuck else self.direction * y[1]
+        stop = self.phi_stop - y[0]
+        if self.coupled:
+            self.coupled_terms(y[0], y[1], o)
+            g[0] = sigma * o[6]
+            g[1] = o[4]
+            g[2] = self.s4 * o[8]
+            g[3] = self.s5 * o[2]
+            acc, psi_dd = o[0], o[3]
+        else:
+            phi_l = y[0] + self.phi_off
+            psi = y[2]
+            alpha = self.alpha[fi]
+            arg = phi_l - psi - alpha
+            f = self.a * _sin(psi + alpha) - self.b * _sin(arg) - self.c * _sin(alpha)
+            gp = self.a * _cos(psi + alpha) + self.b * _cos(arg) - self.c * _cos(alpha)
+            g[0] = sigma * gp
+            g[1] = sigma * f
+            g[2] = 1.0
+            g[3] = 1.0 if self.verge_stuck else self.s5 * y[3]
+            self.free_terms(y, o)
+            acc, psi_dd = o[0], o[1]
+            if (
+                self.has_shift and self.shift_face == self.face
+                and self.shift_phi_off == self.phi_off
+            ):
+                g[1] = g[1] + self.shift
+        g[4] = wheel
+        g[5] = hi
+        g[6] = lo
+        g[7] = stop
+        g[8] = self.ipr_sign * self.s5 * psi_dd
+        if self.live:
+            g[9] = self.i1r_sign * self.direction * acc
+        return 0
+
+    cdef int accept(self, double* y, double t) except -1:
+        """VergeCore.accept (the normal force's peak), or the monolithic model's record
+        (its force maxima; a self-locking point goes to the Python code, which halts)."""
+        cdef double o[13]
+        cdef double p[7]
+        cdef double pn, peak, acc, f12, f23
+        if self.monolithic:
+            if self.coupled:
+                self.coupled_terms(y[0], y[1], o)
+                acc, pn = o[0], o[4]
+                self.parts(y[0], y[1], p)
+                if o[9] <= 0.0 or p[0] <= 0.0:
+                    self.store()
+                    self.core.accept([y[i] for i in range(self.n)], t)
+                    self.load()
+                    return 0
+            else:
+                self.free_terms(y, o)
+                acc = o[0]
+                self.parts(y[0], y[1], p)
+            f23 = p[2] + p[3] * acc
+            f12 = (f23 * p[6] + self.t2 * p[5] - self.i2 * self.n32 * acc) / p[4]
+            if self.coupled:
+                self.f23_max = f23 if f23 > self.f23_max else self.f23_max
+                self.f12_max = f12 if f12 > self.f12_max else self.f12_max
+                self.pn_max = pn if pn > self.pn_max else self.pn_max
+            else:
+                self.ff23_max = f23 if f23 > self.ff23_max else self.ff23_max
+                self.ff12_max = f12 if f12 > self.ff12_max else self.ff12_max
+            return 0
+        if not self.coupled:
+            self.n_points = 0
+            return 0
+        self.coupled_terms(y[0], y[1], o)
+        pn = o[4]
+        t += self.core.t_base
+        if self.n_points == 2:
+            peak = _vertex_c(
+                self.pts[0][0], self.pts[0][1], self.pts[1][0], self.pts[1][1], t, pn
+            )
+            peak = peak if peak > pn else pn
+        else:
+            peak = pn
+        self.pn_peak = peak if peak > self.pn_peak else self.pn_peak
+        if self.n_points == 0:
+            self.n_points = 1
+        else:
+            if self.n_points == 2:
+                self.pts[0][0], self.pts[0][1] = self.pts[1][0], self.pts[1][1]
+            self.n_points = 2
+        self.pts[self.n_points - 1][0] = t
+        self.pts[self.n_points - 1][1] = pn
+        return 0
+
+
+
+cdef class _TrainRun(_Loop):
+    """gear_train._TrainModel (the M739 train with a held escapement load), bare, with its
+    torque ramped over the step (train_component.RampedLoad) or ending at its first event."""
+
+    cdef object train_model
+    cdef bint stuck, ramped
+    cdef double t_esc, j_esc, rate
+    cdef double peaks[4]
+
+    cdef int setup(self, object model, object train_model, object ramp) except -1:
+        self.model, self.train_model = model, train_model
+        self.ramped = ramp is not None
+        self.rate = ramp.rate if self.ramped else 0.0
+        self.n = 4 if self.ramped else 3
+        self.n_ind = 4
+        self.setup_live(train_model.p)
+        self.load()
+        return 0
+
+    cdef int load(self) except -1:
+        m = self.train_model
+        self.load_live(m.p)
+        self.stuck = m.stuck
+        self.t_esc, self.j_esc = m.t_esc, m.j_esc
+        self.peaks[0], self.peaks[1], self.peaks[2], self.peaks[3] = m.peaks
+        self.halted = bool(getattr(self.model, "halted", False))
+        return 0
+
+    cdef int store(self) except -1:
+        m = self.train_model
+        m.peaks = (self.peaks[0], self.peaks[1], self.peaks[2], self.peaks[3])
+        m.t_esc = self.t_esc
+        return 0
+
+    cdef double accel(self, double phi, double phi_dot) except? -2.0:
+        """TrainLoadModel.accel (c_load = 1 for this train)."""
+        cdef double p[7]
+        self.parts(phi, phi_dot, p)
+        return (p[1] + 1.0 * self.t_esc) / (p[0] + 1.0 * self.j_esc)
+
+    cdef int deriv(self, double* y, double* out) except -1:
+        cdef double a, phi = y[0], w = y[1]
+        if self.ramped:
+            self.t_esc = y[3]  # RampedLoad.enter
+            out[3] = self.rate
+        if self.stuck:
+            out[0] = out[1] = out[2] = 0.0
+            return 0
+        a = self.accel(phi, w)
+        out[0] = w
+        out[1] = a
+        out[2] = w * (
+            self.t_esc - self.j_esc * a
+            + -self.n31 * self.a35 * _sin(self.phi1c + self.n31 * phi)
+            - self.i_stot * a
+        )
+        return 0
+
+    cdef int indicators(self, double* y, double* g) except -1:
+        if self.ramped:
+            self.t_esc = y[3]
+        g[0] = self.phi_hi - y[0]
+        g[1] = y[0] - self.phi_lo
+        if self.stuck:
+            g[2] = g[3] = 0.0
+            return 0
+        g[2] = self.direction * y[1]
+        g[3] = self.i1r_sign * self.direction * self.accel(y[0], y[1])
+        return 0
+
+    cdef int accept(self, double* y, double t) except -1:
+        """TrainLoadModel.accept: the mesh-force peaks."""
+        cdef double p[7]
+        cdef double a, f12, f23
+        if self.ramped:
+            self.t_esc = y[3]
+        if self.stuck:
+            return 0
+        a = self.accel(y[0], y[1])
+        self.parts(y[0], y[1], p)
+        f23 = p[2] + p[3] * a
+        f12 = (f23 * p[6] + self.t2 * p[5] - self.i2 * self.n32 * a) / p[4]
+        if self.t_esc != 0.0 or self.j_esc != 0.0:
+            if f12 > self.peaks[0] or f23 > self.peaks[1]:
+                self.peaks[0] = f12 if f12 > self.peaks[0] else self.peaks[0]
+                self.peaks[1] = f23 if f23 > self.peaks[1] else self.peaks[1]
+        elif f12 > self.peaks[2] or f23 > self.peaks[3]:
+            self.peaks[2] = f12 if f12 > self.peaks[2] else self.peaks[2]
+            self.peaks[3] = f23 if f23 > self.peaks[3] else self.peaks[3]
+        return 0
+
+
+def _train_run(model, y):
+    """The compiled loop for gear_train's train model, or None."""
+    cdef _TrainRun run
+    inner = model
+    if type(inner) is CLASSES["until_first_event"]:
+        inner = inner.model
+    ramp = None
+    if type(inner) is CLASSES["ramped_load"]:
+        ramp, inner = inner, inner.model
+        if ramp.n != 3:
+            return None
+    if type(inner) is not CLASSES["train_model"] or type(inner.p) is not CLASSES["live_train"]:
+        return None
+    if len(y) != (4 if ramp is not None else 3):
+        return None
+    run = _TrainRun()
+    run.setup(model, inner, ramp)
+    return run
+
+
 def advance(model, y, double h_total, control, double h_try, double tol_t, long max_events,
             observe):
-    """event_integration.advance compiled for a VergeCore; None for any other model (the
-    Python loop runs it)."""
+    """event_integration.advance compiled for the M739 verge core and train model; None for
+    any other model (the Python loop runs it)."""
     cdef _VergeRun run
+    cdef _Loop train_run
     cdef bint moments = False
     cdef Py_ssize_t n_own
+    if len(control.scales) > len(y):
+        return None
+    if CLASSES["train_model"] is not None and CLASSES["ramped_load"] is not None:
+        train_run = _train_run(model, y)
+        if train_run is not None:
+            return train_run.run(list(y), h_total, control, h_try, tol_t, max_events, observe)
     if CLASSES["verge_core"] is None or CLASSES["moments"] is None:
         return None
     inner = model
@@ -1165,7 +1322,7 @@ def advance(model, y, double h_total, control, double h_try, double tol_t, long 
     train = core.train
     if type(train) is not CLASSES["held_train"] and type(train) is not CLASSES["live_train"]:
         return None
-    if n_own != 5 or len(y) != n_own + (3 if moments else 0) or len(control.scales) > len(y):
+    if n_own != 5 or len(y) != n_own + (3 if moments else 0):
         return None
     run = _VergeRun()
     run.setup(model, core, moments, n_own)
