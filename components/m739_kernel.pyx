@@ -2,8 +2,9 @@
 # cython: cdivision=False, initializedcheck=False
 """Compiled twins of the M739 hot paths: the verge's coupled kinematics and contact terms
 (components.verge_geometry, components.verge_escapement), the train's response parts
-(components.gear_train) and one Dormand-Prince step with its dense output
-(components.event_integration).
+(components.gear_train), one Dormand-Prince step with its dense output
+(components.event_integration), and the whole loop between events (``advance``) for the
+M739 verge core, its monolithic model and the M739 train's model.
 
 Each function repeats its Python original operation for operation, in the same order,
 so that results are the same bits: ``x ** 2`` is libm's pow as in CPython (built with
