@@ -806,7 +806,7 @@ cdef class _Loop:
                 n_events += fired
                 recent.append(first)
                 if n_events > max_events:
-                    which = ", ".join(str(i) for i in sorted(set(recent[-20:])))
+                    which = ", ".join(str(i) for i in sorted(set(recent[max(0, len(recent) - 20):])))
                     raise COMPONENT_ERROR(
                         f"too many events inside one step (chattering: indicators {which}, "
                         f"{t:.6g} s into the step)"
@@ -863,8 +863,8 @@ cdef class _VergeRun(_Loop):
         self.beta3, self.gamma_pp, self.dn1 = k.beta3, k.gamma_pp, k.dn1
         self.ip, self.a54 = k.ip, k.a54
         self.rho3, self.rho_p, self.rcp, self.mp, self.r4 = d.rho3, d.rho_p, d.rcp, d.mp, d.r4
-        self.alpha[1], self.alpha[0] = k.alpha[1], k.alpha[-1]
-        self.c1[1], self.c1[0] = k.c1[1], k.c1[-1]
+        self.alpha[1], self.alpha[0] = k.alpha.get(1), k.alpha.get(-1)
+        self.c1[1], self.c1[0] = k.c1.get(1), k.c1.get(-1)
         self.phi_stop = core.phi_stop
         if self.live:
             self.setup_live(self.train)

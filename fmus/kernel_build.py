@@ -89,6 +89,7 @@ def kernel_plan() -> KernelPlan:
     h.update(cython_version.encode())
     h.update((include / "patchlevel.h").read_bytes())
     h.update(sysconfig.get_config_var("EXT_SUFFIX").encode())
+    h.update(Path(__file__).read_bytes())  # how it is built
     return KernelPlan(compiler, "", f"kernels {h.hexdigest()}")
 
 
@@ -128,7 +129,21 @@ def _compile(name: str, compiler: str) -> bytes:
             if run.returncode != 0:
                 words = (run.stderr or run.stdout).strip() or f"exit {run.returncode}"
                 raise RuntimeError(f"{' '.join(command)}: {words}")
+            if command[0] == sys.executable:
+                _python_messages(Path(tmp) / f"{name}.c")
         return (Path(tmp) / f"{name}.so").read_bytes()
+
+
+def _python_messages(source: Path) -> None:
+    """Cython's division by zero says "float division"; Python's "float division by zero".
+    A message can reach a result (a run's failure reason), so the kernel says Python's."""
+    text = source.read_text()
+    source.write_text(
+        text.replace(
+            'PyExc_ZeroDivisionError, "float division")',
+            'PyExc_ZeroDivisionError, "float division by zero")',
+        )
+    )
 
 
 def kernel_library(name: str, cache_dir: Path | None = None) -> Path | None:
