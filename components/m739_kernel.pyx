@@ -439,6 +439,24 @@ cdef class _Dense:
         ]
 
 
+cdef class Sampler:
+    """The monolithic model's observer (orchestrator.scenes.m739.monolithic.simulate), run
+    in C by the compiled loop; any other loop calls it as the Python observer it wraps.
+    ``columns``: the lists t, phi, phi_dot, psi, psi_dot, regime, f12, f23, pn; ``count``:
+    a one-element list, the index of the next sample (shared with the Python observer)."""
+
+    cdef readonly object core, observe
+    cdef readonly list columns, count
+    cdef readonly double dt, psic0
+
+    def __init__(self, core, observe, list columns, list count, double dt, double psic0):
+        self.core, self.observe, self.columns, self.count = core, observe, columns, count
+        self.dt, self.psic0 = dt, psic0
+
+    def __call__(self, t0, t1, state_at):
+        return self.observe(t0, t1, state_at)
+
+
 cdef class _Loop:
     """event_integration.advance on C arrays for one model (a subclass gives its deriv,
     indicators, accept, and how its mode is read from and written back to Python), with
@@ -469,6 +487,14 @@ cdef class _Loop:
         return 0
 
     cdef int store(self) except -1:
+        return 0
+
+    cdef bint sample_ready(self, Sampler sampler) except -1:
+        return False
+
+    cdef int sample(
+        self, Sampler sampler, double r[5][MAX_STATES], double t0, double h, double t1
+    ) except -1:
         return 0
 
     cdef int setup_live(self, object tr) except -1:
@@ -686,6 +712,7 @@ cdef class _Loop:
         recent = []
         dense.n = n
         model = self.model
+        sampler = observe if type(observe) is Sampler and self.sample_ready(observe) else None
         try:
             self.indicators(Y, G0)
             self.deriv(Y, K1)
@@ -768,7 +795,9 @@ cdef class _Loop:
                             for j in range(n):
                                 YB[j] = YT[j]
                             break
-                if observe is not None:
+                if sampler is not None:
+                    self.sample(sampler, dense.r, t, h_step, t + th_best)
+                elif observe is not None:
                     dense.t0, dense.h = t, h_step
                     observe(t, t + th_best, dense)
                     dense = _Dense()
@@ -1120,6 +1149,53 @@ cdef class _VergeRun(_Loop):
         g[8] = self.ipr_sign * self.s5 * psi_dd
         if self.live:
             g[9] = self.i1r_sign * self.direction * acc
+        return 0
+
+    cdef bint sample_ready(self, Sampler sampler) except -1:
+        return sampler.core is self.core and self.live and self.n == 5
+
+    cdef int sample(
+        self, Sampler sampler, double r[5][MAX_STATES], double t0, double h, double t1
+    ) except -1:
+        """The monolithic model's observer (orchestrator.scenes.m739.monolithic.simulate):
+        the samples every sample_dt on the dense output of the step, each with the forces."""
+        cdef double y[MAX_STATES]
+        cdef double o[13]
+        cdef double p[7]
+        cdef double t_base = self.core.t_base, dt = sampler.dt, t_abs, th, s1, body, acc, pn
+        cdef double f12, f23
+        cdef long count = sampler.count[0]
+        cdef Py_ssize_t i
+        cdef int regime
+        cols = sampler.columns
+        while count * dt - t_base <= t1:
+            t_abs = count * dt
+            th = ((t_abs - t_base) - t0) / h
+            s1 = 1.0 - th
+            for i in range(self.n):
+                y[i] = r[0][i] + th * (r[1][i] + s1 * (r[2][i] + th * (r[3][i] + s1 * r[4][i])))
+            body = y[2] + self.psic - sampler.psic0
+            regime = 0 if not self.coupled else (1 if self.face == 1 else 2)
+            if self.coupled:
+                self.coupled_terms(y[0], y[1], o)
+                acc, pn = o[0], o[4]
+            else:
+                self.free_terms(y, o)
+                acc, pn = o[0], 0.0
+            self.parts(y[0], y[1], p)
+            f23 = p[2] + p[3] * acc
+            f12 = (f23 * p[6] + self.t2 * p[5] - self.i2 * self.n32 * acc) / p[4]
+            cols[0].append(t_abs)
+            cols[1].append(y[0])
+            cols[2].append(y[1])
+            cols[3].append(atan2(_sin(body), _cos(body)))
+            cols[4].append(y[3])
+            cols[5].append(regime)
+            cols[6].append(f12)
+            cols[7].append(f23)
+            cols[8].append(pn)
+            count += 1
+            sampler.count[0] = count
         return 0
 
     cdef int accept(self, double* y, double t) except -1:

@@ -267,6 +267,10 @@ def simulate(
             sample(t_abs, state_at(t_abs - core.t_base))
             count[0] += 1
 
+    if _KERNEL is not None:  # the same samples, taken inside the compiled loop
+        columns = [cols[n] for n in names]
+        observe = _KERNEL.Sampler(core, observe, columns, count, sample_dt, data.psic)
+
     try:
         while t < t_stop and not core.halted and not core.train_stuck:
             h = min(OUTPUT_CHUNK, t_stop - t)
