@@ -853,6 +853,7 @@ cdef class _VergeRun(_Loop):
 
     cdef object core, train
     cdef bint monolithic, live, moments, has_budget
+    cdef bint bare  # the core's own deriv and indicators only (verge_deriv, verge_indicators)
     cdef Py_ssize_t n_own
     cdef long long budget
     # VergeConstants
@@ -878,7 +879,7 @@ cdef class _VergeRun(_Loop):
 
     cdef int setup(self, object model, object core, bint moments, Py_ssize_t n_own) except -1:
         self.model, self.core, self.train = model, core, core.train
-        self.monolithic = type(core) is CLASSES["monolithic"]
+        self.monolithic = type(core) is CLASSES["monolithic"] and not self.bare
         self.live = type(self.train) is CLASSES["live_train"]
         self.moments = moments
         self.n_own = n_own
@@ -918,6 +919,8 @@ cdef class _VergeRun(_Loop):
             self.j_ref, self.t_ref, self.c_load = tr.j_ref, tr.t_ref, tr.c_load
             self.j_phi, self.t_phi, self.t_w = tr.j_phi, tr.t_phi, tr.t_w
             self.phi0, self.w0 = tr.phi0, tr.w0
+        if self.bare:
+            return 0
         if self.monolithic:
             shift = core.gap_shift
             self.has_shift = shift is not None
@@ -1364,6 +1367,60 @@ def _train_run(model, y):
     run = _TrainRun()
     run.setup(model, inner, ramp)
     return run
+
+
+# VergeCore's own deriv and indicators for the Python code that calls them (its events, the
+# component's step): the same C functions, the mode read for each call.
+cdef dict PYTHON_VERGE = {}
+
+
+def use_python_verge(**functions):
+    """VergeCore's Python deriv and indicators, for a core whose train is neither kind."""
+    PYTHON_VERGE.update(functions)
+
+
+cdef _VergeRun _bare_run(object core, object y):
+    train = core.train
+    if CLASSES["verge_core"] is None or len(y) < 5:
+        return None
+    if type(train) is not CLASSES["held_train"] and type(train) is not CLASSES["live_train"]:
+        return None
+    run = _VergeRun()
+    run.bare = True
+    run.setup(None, core, False, 5)
+    return run
+
+
+def verge_indicators(self, y):
+    """VergeCore.indicators."""
+    cdef double Y[5]
+    cdef double g[16]
+    cdef Py_ssize_t i
+    cdef _VergeRun run = _bare_run(self, y)
+    if run is None:
+        return PYTHON_VERGE["indicators"](self, y)
+    for i in range(5):
+        Y[i] = y[i]
+    try:
+        run.indicators(Y, g)
+    finally:
+        if run.has_budget:
+            self.budget = run.budget
+    return tuple([g[i] for i in range(run.n_ind)])
+
+
+def verge_deriv(self, y):
+    """VergeCore.deriv."""
+    cdef double Y[5]
+    cdef double out[5]
+    cdef Py_ssize_t i
+    cdef _VergeRun run = _bare_run(self, y)
+    if run is None:
+        return PYTHON_VERGE["deriv"](self, y)
+    for i in range(5):
+        Y[i] = y[i]
+    run.deriv(Y, out)
+    return [out[0], out[1], out[2], out[3], out[4]]
 
 
 def advance(model, y, double h_total, control, double h_try, double tol_t, long max_events,

@@ -1241,3 +1241,6 @@ if _KERNEL is not None:  # the compiled twins (components.kernels): the same res
         torque_at=VergeEscapement._torque_at,
         verge_budget_spent=StepBudgetSpent,
     )
+    _KERNEL.use_python_verge(indicators=VergeCore.indicators, deriv=VergeCore.deriv)
+    VergeCore.indicators = _KERNEL.verge_indicators  # type: ignore[method-assign]
+    VergeCore.deriv = _KERNEL.verge_deriv  # type: ignore[method-assign]
