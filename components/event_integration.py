@@ -21,6 +21,7 @@ from dataclasses import dataclass, replace
 from typing import NamedTuple, Protocol
 
 from .base import ComponentError, Variable
+from .kernels import load_kernel
 
 
 class EventModel(Protocol):
@@ -398,6 +399,10 @@ def advance(
     before the mode changes: ``state_at(t)`` is the state at any t in [t0, t1] (offsets
     from the start), e.g. for output at fixed times without shortening the steps.
     """
+    if _COMPILED is not None:  # the same loop in C, for the models it knows (else None)
+        done = _COMPILED(model, y, h_total, control, h_try, tol_t, max_events, observe)
+        if done is not None:
+            return Advanced(*done)
     deriv = model.deriv
     accept = getattr(model, "accept", None)
     t = 0.0
@@ -493,3 +498,13 @@ def advance(
         if getattr(model, "halted", False):
             break
     return Advanced(y, t_first, t_event, n_events, h_next, steps, rejected)
+
+
+_COMPILED: Callable[..., tuple | None] | None = None
+_KERNEL = load_kernel("m739_kernel")
+if _KERNEL is not None:  # the compiled twins (components.kernels): the same results
+    _KERNEL.use_step_type(_Step, _dp5_step)
+    _KERNEL.use_integration(ComponentError, StepBudgetSpent, _fire_at_instant, _first_step)
+    _COMPILED = _KERNEL.advance
+    _dp5_step = _KERNEL.dp5_step
+    dense_state = _KERNEL.dense_state

@@ -57,6 +57,7 @@ from .escape_wheel import (
     response_slope_outputs,
 )
 from .event_integration import INTEGRATION_VARIABLES
+from .kernels import load_kernel
 from .m739_data import M739, M739Data
 from .sanda2v_deck import TRAIN, deck_variables, design_of, train_violations
 from .train_component import TrainComponent, TrainLoadModel
@@ -550,3 +551,9 @@ class GearTrain(TrainComponent):
         # Work of the spin (centrifugal moment on the eccentric rotor) since the start.
         self.external_work = p.a35 * (math.cos(self._data.phi1c + p.n31 * phi) - self._cos0)
         self.dissipated_work = wd
+
+
+_KERNEL = load_kernel("m739_kernel")
+if _KERNEL is not None:  # the compiled twin (components.kernels): the same results
+    TrainPhysics._parts = _KERNEL.train_parts
+    _KERNEL.use_classes(live_train=TrainPhysics, train_model=_TrainModel)

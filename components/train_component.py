@@ -11,6 +11,7 @@ from .augmented_model import AugmentedModel
 from .base import Component, SnapshotPlan
 from .early_return import UntilFirstEvent, reached
 from .event_integration import STEP_BUDGET_VARIABLE, advance, integration_step_control
+from .kernels import load_kernel
 
 #: Magnitudes below which the integration controls the state [phi, phi_d, W] absolutely:
 #: rad, rad/s, J.
@@ -245,3 +246,8 @@ class TrainComponent(Component):
             self.t_event = t + m.t_first_event
         self._outputs()
         self._peak_outputs()
+
+
+_KERNEL = load_kernel("m739_kernel")
+if _KERNEL is not None:  # the loop between events in C for the M739 train's model
+    _KERNEL.use_classes(ramped_load=RampedLoad, until_first_event=UntilFirstEvent)

@@ -59,6 +59,7 @@ from .design_rules import raise_first
 from .early_return import EARLY_RETURN_VARIABLES, UntilFirstEvent, reached
 from .escape_wheel import ESCAPE_WHEEL_PORT
 from .event_integration import INTEGRATION_VARIABLES, advance, integration_step_control
+from .kernels import load_kernel
 from .m739_data import M739, M739Data
 from .sanda2v_deck import VERGE, deck_variables, design_of, verge_violations
 from .step_moments import WithMoments
@@ -1255,3 +1256,21 @@ class VergeEscapement(Component):
         # Work of the spin on an eccentric pallet (zero for r_cp = 0).
         self.external_work = k.a54 * (math.cos(k.gamma_pp - psi - core.psic) - self._cos0)
         self.dissipated_work = y[4]
+
+
+_KERNEL = load_kernel("m739_kernel")
+if _KERNEL is not None:  # the compiled twins (components.kernels): the same results
+    contact_coefficients = _KERNEL.contact_coefficients
+    VergeCore._coupled_terms = _KERNEL.coupled_terms
+    # the loop between events in C for these (event_integration.advance)
+    _KERNEL.use_classes(
+        verge_core=VergeCore,
+        held_train=HeldTrain,
+        moments=WithMoments,
+        until_first_event=UntilFirstEvent,
+        torque_at=VergeEscapement._torque_at,
+        verge_budget_spent=StepBudgetSpent,
+    )
+    _KERNEL.use_python_verge(indicators=VergeCore.indicators, deriv=VergeCore.deriv)
+    VergeCore.indicators = _KERNEL.verge_indicators  # type: ignore[method-assign]
+    VergeCore.deriv = _KERNEL.verge_deriv  # type: ignore[method-assign]

@@ -15,6 +15,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from .kernels import load_kernel
 from .m739_data import M739Data
 
 TWO_PI = 2.0 * math.pi
@@ -178,3 +179,9 @@ def impact_map(
     ) / den
     psi_f = (phi_f * a1p - e_rest * (psi_dot * d1p - phi_dot * a1p)) / d1p
     return phi_f, psi_f
+
+
+_KERNEL = load_kernel("m739_kernel")
+if _KERNEL is not None:  # the compiled twins (components.kernels): the same results
+    kinem = _KERNEL.kinem
+    sliding_velocity = _KERNEL.sliding_velocity

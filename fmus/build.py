@@ -34,6 +34,12 @@ from components.base import Component
 from fmus.description import complete_description
 from fmus.documentation import render_documentation
 from fmus.host_loader import LOADER_SOURCE, loader_binary, loader_plan, pack_loader
+from fmus.kernel_build import (
+    KERNEL_SOURCES,
+    compiled_kernel,
+    default_cache_dir,
+    kernel_identity,
+)
 from fmus.registry import FMU_RECORDS, FmuRecord, RecordError
 
 FMUS_DIR = Path(__file__).resolve().parent
@@ -49,6 +55,7 @@ BUILD_CODE = (
     FMUS_DIR / "ports.py",
     FMUS_DIR / "units.py",
     FMUS_DIR / "host_loader.py",
+    FMUS_DIR / "kernel_build.py",
     LOADER_SOURCE,
 )
 #: the date of every entry of an FMU archive (the earliest a zip file can hold)
@@ -57,15 +64,6 @@ ZIP_DATE = (1980, 1, 1, 0, 0, 0)
 
 class BuildError(RuntimeError):
     """An FMU cannot be built (unknown name, unwritable cache, undeclared requirement)."""
-
-
-def default_cache_dir() -> Path:
-    """Where built FMUs live: $MECHCOSIM_FMU_CACHE, else the user cache directory."""
-    env = os.environ.get("MECHCOSIM_FMU_CACHE")
-    if env:
-        return Path(env)
-    base = Path(os.environ.get("XDG_CACHE_HOME", Path.home() / ".cache"))
-    return base / "mechcosim" / "fmus"
 
 
 def content_hash(record: FmuRecord) -> str:
@@ -80,6 +78,8 @@ def content_hash(record: FmuRecord) -> str:
         h.update(f.read_bytes())
     h.update(pythonfmu.__version__.encode())
     h.update(loader_plan().identity.encode())  # the compiler and the Python it names
+    for kernel in _kernels(record.modules()):  # compiled kernels: source, Cython, compiler
+        h.update(kernel_identity(kernel).encode())
     return h.hexdigest()
 
 
@@ -116,6 +116,11 @@ def build_fmu(name: str, cache_dir: Path | None = None, force: bool = False) -> 
     return target
 
 
+def _kernels(modules: list[Path]) -> list[str]:
+    """The compiled kernels an FMU ships: all of them where its code loads kernels."""
+    return sorted(KERNEL_SOURCES) if any(m.name == "kernels.py" for m in modules) else []
+
+
 def package_name(digest: str) -> str:
     """The package an FMU's Python code is packed as: unique to the build."""
     return f"mechcosim_{digest}"
@@ -131,6 +136,10 @@ def _build(record: FmuRecord, digest: str, needs: list[str], tmp: Path) -> Path:
     shutil.copy2(SLAVE_MODULE, code)
     for module in modules:
         shutil.copy2(module, code / "components")
+    for kernel in _kernels(modules):  # beside the Python code; without it that code runs
+        binary = compiled_kernel(kernel, kernel_identity(kernel))
+        if binary is not None:
+            (code / "components" / f"{kernel}.so").write_bytes(binary)
     script = stage / f"{record.script.stem}_{digest}.py"
     script.write_text(
         re.sub(

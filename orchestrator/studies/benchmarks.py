@@ -6,7 +6,12 @@ macro step, against the same physics stepped as plain Python objects.
 
 from __future__ import annotations
 
+import json
 import math
+import os
+import statistics
+import subprocess
+import sys
 import time
 from collections.abc import Callable
 from functools import partial
@@ -408,13 +413,98 @@ def _press_feed_rows(budget: float = 1e-3) -> list[tuple[str, float, str]]:
     return rows
 
 
+#: Processes of each path the kernel rows take, in turn (the machine may be shared).
+KERNEL_ROUNDS = 2
+
+
+def _cpu_time(fn: Callable[[], object]) -> float:
+    """Process time of fn() [s]: CPU time is what the paths differ in on a shared machine."""
+    t0 = time.process_time()
+    fn()
+    return time.process_time() - t0
+
+
+def kernel_timings(tolerance: float = 1e-6, repeats: int = 3) -> dict[str, object]:
+    """Process times of the M739 scene as written (no reference) and of its monolithic
+    model at ``tolerance``, run in turn ``repeats`` times after one untimed run: with the
+    compiled kernels or without, as this process loaded them (``components.kernels``)."""
+    from components.kernels import load_kernel
+
+    scene = load_scene(SCENARIOS / "m739.toml", {})
+    _run(scene, compare_reference=False)  # FMUs extracted and loaded, caches warm
+    cosim, mono = [], []
+    for _ in range(repeats):
+        cosim.append(_cpu_time(partial(_run, scene, compare_reference=False)))
+        mono.append(_cpu_time(partial(run_m739, tolerance=tolerance)))
+    return {"cosim": cosim, "monolithic": mono, "compiled": load_kernel("m739_kernel") is not None}
+
+
+def _kernel_process(pure: bool) -> dict[str, object]:
+    """kernel_timings in a process of its own (the kernels are bound when the physics is
+    imported, so the two paths need two processes)."""
+    env = {k: v for k, v in os.environ.items() if k != "MECHCOSIM_PURE_PYTHON"}
+    if pure:
+        env["MECHCOSIM_PURE_PYTHON"] = "1"
+    code = (
+        "import json; from orchestrator.studies.benchmarks import kernel_timings; "
+        "print(json.dumps(kernel_timings()))"
+    )
+    run = subprocess.run(
+        [sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True
+    )
+    return json.loads(run.stdout.strip().splitlines()[-1])
+
+
+def _kernel_rows() -> list[tuple[str, float, str]]:
+    """The compiled kernels' targets: the M739 co-simulation with compiled kernels against the Python
+    fallback, and against the compiled and the Python monolithic model (tolerance 1e-6):
+    medians of process times, the two paths' processes run in turn."""
+    times: dict[bool, dict[str, list[float]]] = {
+        p: {"cosim": [], "monolithic": []} for p in (False, True)
+    }
+    compiled = True
+    for _ in range(KERNEL_ROUNDS):
+        for pure in (False, True):
+            got = _kernel_process(pure)
+            compiled = compiled and (pure or bool(got["compiled"]))
+            for what in ("cosim", "monolithic"):
+                times[pure][what] += got[what]  # type: ignore[operator]
+    if not compiled:
+        print("no compiled kernels here (see the line above): the two paths are the same")
+    fast = {k: statistics.median(v) for k, v in times[False].items()}
+    slow = {k: statistics.median(v) for k, v in times[True].items()}
+    print(
+        f"M739 as written, CPU time: co-simulation {fast['cosim']:.3f} s compiled, "
+        f"{slow['cosim']:.3f} s Python; monolithic (1e-6) {fast['monolithic']:.3f} s "
+        f"compiled, {slow['monolithic']:.3f} s Python"
+    )
+    return [
+        ("M739 co-simulation: Python fallback / compiled", slow["cosim"] / fast["cosim"], ">= 3.5"),
+        (
+            "M739 co-simulation, compiled / compiled monolithic (1e-6)",
+            fast["cosim"] / fast["monolithic"],
+            "<= 4",
+        ),
+        (
+            "M739 co-simulation, compiled / Python monolithic (1e-6)",
+            fast["cosim"] / slow["monolithic"],
+            "",
+        ),
+        (
+            "M739 monolithic (1e-6): Python / compiled",
+            slow["monolithic"] / fast["monolithic"],
+            "",
+        ),
+    ]
+
+
 def speed() -> None:
     """Run time against the monolithic models at the same accuracy, all measured here.
 
     Truths: the monolithic models at tolerance 1e-12.  The monolithic time is that of the
     loosest tolerance whose turns error is within the same budget as the co-simulation's.
     """
-    rows = _monolithic_rows() + _press_feed_rows() + _sweep_throughput()
+    rows = _kernel_rows() + _monolithic_rows() + _press_feed_rows() + _sweep_throughput()
     width = max(len(what) for what, _, _ in rows)
     print(f"\n{'ratio':{width}s} {'measured':>9s} {'target':>7s}")
     for what, ratio, target in rows:

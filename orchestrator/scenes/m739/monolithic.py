@@ -34,6 +34,7 @@ from components.gear_train import (
     TRAIN_STUCK,
     TrainPhysics,
 )
+from components.kernels import load_kernel
 from components.m739_data import LBF, M739, M739Data, rpm_to_rad_s
 from components.verge_escapement import (
     IND_CONTACT,
@@ -164,6 +165,11 @@ class VergeTrainMonolithic(VergeCore):
         return y
 
 
+_KERNEL = load_kernel("m739_kernel")
+if _KERNEL is not None:  # its integration between events runs compiled (components.kernels)
+    _KERNEL.use_classes(monolithic=VergeTrainMonolithic)
+
+
 def _indexing_code(indexing: int | str) -> int:
     if isinstance(indexing, str):
         key = indexing.strip().lower().replace("_", "-")
@@ -260,6 +266,10 @@ def simulate(
             t_abs = count[0] * sample_dt
             sample(t_abs, state_at(t_abs - core.t_base))
             count[0] += 1
+
+    if _KERNEL is not None:  # the same samples, taken inside the compiled loop
+        columns = [cols[n] for n in names]
+        observe = _KERNEL.Sampler(core, observe, columns, count, sample_dt, data.psic)
 
     try:
         while t < t_stop and not core.halted and not core.train_stuck:
