@@ -431,11 +431,12 @@ def kernel_timings(tolerance: float = 1e-6, repeats: int = 3) -> dict[str, objec
     from components.kernels import load_kernel
 
     scene = load_scene(SCENARIOS / "m739.toml", {})
+    _, monolithic = monolithic_model(scene)  # the scene's physics, as its reference runs it
     _run(scene, compare_reference=False)  # FMUs extracted and loaded, caches warm
     cosim, mono = [], []
     for _ in range(repeats):
         cosim.append(_cpu_time(partial(_run, scene, compare_reference=False)))
-        mono.append(_cpu_time(partial(run_m739, tolerance=tolerance)))
+        mono.append(_cpu_time(partial(monolithic, tolerance)))
     return {"cosim": cosim, "monolithic": mono, "compiled": load_kernel("m739_kernel") is not None}
 
 
@@ -456,8 +457,8 @@ def _kernel_process(pure: bool) -> dict[str, object]:
 
 
 def _kernel_rows() -> list[tuple[str, float, str]]:
-    """The compiled kernels' targets: the M739 co-simulation with compiled kernels against the Python
-    fallback, and against the compiled and the Python monolithic model (tolerance 1e-6):
+    """The compiled kernels' targets: the M739 co-simulation with compiled kernels against
+    the Python fallback, and against the compiled and the Python monolithic model (tolerance 1e-6):
     medians of process times, the two paths' processes run in turn."""
     times: dict[bool, dict[str, list[float]]] = {
         p: {"cosim": [], "monolithic": []} for p in (False, True)
