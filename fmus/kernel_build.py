@@ -100,10 +100,19 @@ def kernel_identity(name: str) -> str:
     return h.hexdigest()
 
 
-@cache
 def compiled_kernel(name: str, identity: str) -> bytes | None:
-    """The kernel's shared library, compiled once per process and identity; None (said in
-    one line) where it cannot be built."""
+    """The kernel's shared library: from the FMU cache's ``kernels/``, built there if
+    missing (one compilation serves every process that builds FMUs); None (said in one
+    line) where it cannot be built."""
+    library = kernel_library(name)
+    if library is not None:
+        return library.read_bytes()
+    return _compiled(name, identity)
+
+
+@cache
+def _compiled(name: str, identity: str) -> bytes | None:
+    """The kernel compiled in this process, once per identity; None where it cannot be."""
     plan = kernel_plan()
     why_not = plan.why_not
     if plan.compiler is not None:
@@ -154,7 +163,7 @@ def kernel_library(name: str, cache_dir: Path | None = None) -> Path | None:
     target = Path(cache_dir) / "kernels" / f"{name}-{kernel_identity(name)[:16]}.so"
     if target.is_file():
         return target
-    binary = compiled_kernel(name, kernel_identity(name))
+    binary = _compiled(name, kernel_identity(name))
     if binary is None:
         return None
     try:
