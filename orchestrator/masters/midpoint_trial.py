@@ -17,7 +17,11 @@ Where an FMU takes a held input's rate over the step (a Real input with the role
 it, neither connected nor driven: the press feed's drive and brake take the clutch
 torque's), the corrector also sets that rate, the slope from the start to the predicted
 end value, so the input ramps through the step (first-order hold) rather than sitting at
-its mean: the receiver then takes the first moment of its change too.
+its mean: the receiver then takes the first moment of its change too.  A black box that
+declares it interpolates its inputs (FMI 2.0 ``canInterpolateInputs``, and no rate_of input
+of its own) takes that slope by fmi2SetRealInputDerivatives, its input held at its start
+value and ramped from there (the predictor's slope is 0); its inputs' change then is judged
+by the corrector, not by the first-order change measure.
 
 A predictor that crosses a switch is shortened to it; the step that lands on it is
 corrected with the end values predicted just before the switch (those after it would
@@ -31,7 +35,7 @@ from dataclasses import dataclass
 from typing import Any, NamedTuple
 
 from orchestrator.master_settings import RegimeAwareSettings
-from orchestrator.masters.held_inputs import HeldInputs
+from orchestrator.masters.held_inputs import HeldInput, HeldInputs
 from orchestrator.masters.regime_aware import Estimate, RestartSteps, Trial
 from orchestrator.masters.switches import Landing, StepStart, Switch, back_to_start, switch_time
 from orchestrator.recorder import StepStats
@@ -62,6 +66,14 @@ class _Ramp(NamedTuple):
     setter: Any  # sets the instance's rate input
 
 
+class _Slopes(NamedTuple):
+    """The inputs of one FMU it ramps by the slopes fmi2SetRealInputDerivatives gives."""
+
+    instance: int
+    indices: list[int]  # of the inputs in its instance's feed order
+    setter: Any  # sets their first derivatives
+
+
 class MidpointTrials:
     """Predictor (and with the midpoint hold, corrector) trials; see the module doc."""
 
@@ -81,14 +93,19 @@ class MidpointTrials:
         self.midpoint = settings.midpoint
         self.held = HeldInputs(system)
         self.ramps = self._ramps() if self.midpoint else []
+        self.slopes = self._slopes() if self.midpoint else []
+        #: the black-box signals whose change is the first-order error measure
+        self.unsloped = self.held.unsloped if self.midpoint else self.held.unannotated
         self._ramps_set: dict[tuple[int, int], tuple[int, float]] = {}
         #: FMU states the predictors of this macro step kept, freed at its end
         self._kept: list[list[Any]] = []
         control = settings.control
         self.restart = RestartSteps(settings.first_step, control.zero_error_restart, True)
-        if self.held.black_boxes and self.midpoint:
+        sloped = {system.names[j] for j, _, _ in self.slopes}
+        held_boxes = [b for b in self.held.black_boxes if b not in sloped]
+        if held_boxes and self.midpoint:
             stats.extra.setdefault("warnings", []).append(
-                f"FMU {', '.join(map(repr, self.held.black_boxes))} declares no sampled "
+                f"FMU {', '.join(map(repr, held_boxes))} declares no sampled "
                 "inputs, event indicators or regimes: its inputs are held at the step start "
                 "(first order in the step, the step sized by their change) and its internal "
                 "switches are found only through the error test"
@@ -170,6 +187,8 @@ class MidpointTrials:
             system.feed(i)
         if self.ramps:
             self._set_ramps({})
+        for _, indices, setter in self.slopes:
+            setter([0.0] * len(indices))
         return _Predictor(t, h, self._step_all(t, h, keep=self.midpoint))
 
     def _step_all(
@@ -209,14 +228,14 @@ class MidpointTrials:
         feeds, retake = [], []
         at_predictor = at is not None and (at.t, at.h) == (t, h) and at.states is not None
         for i, inputs in enumerate(self.held.inputs):
-            reals = [
-                0.5 * (values0[s][k] + predicted[s][k]) if averaged else values0[s][k]
-                for (s, k), averaged, _ in inputs
-            ]
+            reals = [_corrector_input(held, values0, predicted) for held in inputs]
             feeds.append(reals)
             # An FMU whose held inputs the correction leaves as they were would retake
             # the predictor's very step: when it is at its end, it stays (a doStep fewer).
-            if not (at_predictor and _same(reals, [values0[s][k] for (s, k), _, _ in inputs])):
+            changed = not _same(reals, [values0[s][k] for (s, k), *_ in inputs]) or any(
+                predicted[s][k] != values0[s][k] for (s, k), _, _, sloped in inputs if sloped
+            )
+            if not (at_predictor and not changed):
                 retake.append(i)
         # Back to the step start, those that stay to the end of their predictor step.
         kept = at.states if at is not None else None
@@ -231,6 +250,9 @@ class MidpointTrials:
                 s, n = self.held.inputs[j][k].source
                 rates[(j, k)] = (predicted[s][n] - values0[s][n]) / h
             self._set_ramps(rates)
+        for j, indices, setter in self.slopes:
+            sources = [self.held.inputs[j][k].source for k in indices]
+            setter([(predicted[s][n] - values0[s][n]) / h for s, n in sources])
         self._step_all(t, h, retake)
         worst, tol = 0.0, self.settings.tolerance
         values = system.values
@@ -280,9 +302,7 @@ class MidpointTrials:
         held, tol = self.held, self.settings.tolerance
         if not self.midpoint:
             return Estimate(held.change_ratio(start.before, held.signals, tol), True)
-        unannotated = (
-            held.change_ratio(start.before, held.unannotated, tol) if held.unannotated else 0.0
-        )
+        unannotated = held.change_ratio(start.before, self.unsloped, tol) if self.unsloped else 0.0
         return Estimate(max(correction.ratio, unannotated), unannotated > correction.ratio)
 
     # -- ramped inputs -----------------------------------------------------------------
@@ -295,6 +315,17 @@ class MidpointTrials:
                 if setter is not None:
                     ramps.append(_Ramp(j, k, setter))
         return ramps
+
+    def _slopes(self) -> list[_Slopes]:
+        """Per FMU that takes input derivatives, the inputs it ramps by them."""
+        slopes = []
+        for j, inputs in enumerate(self.held.inputs):
+            indices = [k for k, held in enumerate(inputs) if held.interpolated]
+            if indices:
+                inst = self.system.instances[j]
+                refs = inst.refs([inputs[k].name for k in indices])
+                slopes.append(_Slopes(j, indices, inst.derivative_setter(refs)))
+        return slopes
 
     def _rate_input(self, j: int, name: str) -> Any:
         """A setter of instance j's input with the role rate_of ``name``, None where it takes
@@ -321,6 +352,17 @@ class MidpointTrials:
             if self._ramps_set.get((j, k)) != key:
                 setter([value])
                 self._ramps_set[(j, k)] = key
+
+
+def _corrector_input(
+    held: HeldInput, values0: list[list[float]], predicted: list[list[float]]
+) -> float:
+    """A held input's value on the corrector step: its step mean where averaged (unless
+    its FMU ramps it from the start by an input derivative), else its step-start value."""
+    s, k = held.source
+    if held.averaged and not held.interpolated:
+        return 0.5 * (values0[s][k] + predicted[s][k])
+    return values0[s][k]
 
 
 def _same(a: list[float], b: list[float]) -> bool:

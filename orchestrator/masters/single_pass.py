@@ -176,7 +176,7 @@ class SinglePassTrials:
         start, now = before.values, self.system.values
         ex, means = self.extrapolation, self.means
         row = []
-        for (s, k), averaged, _ in self.held.inputs[i]:
+        for (s, k), averaged, *_ in self.held.inputs[i]:
             mean = means.get((s, k)) if s in done else None
             if mean is not None:
                 row.append(now[s][mean])
