@@ -8,6 +8,9 @@ T + dT h/2."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
+import numpy as np
 import pytest
 from fmpy import extract, read_model_description
 from fmpy.fmi1 import FMICallException
@@ -16,12 +19,17 @@ from fmpy.fmi2 import FMU2Slave
 from fmus.build import build_fmu
 from fmus.host_loader import loader_plan
 from fmus.input_derivatives import RAMPS_FILE
+from orchestrator import capabilities
+from orchestrator.masters.midpoint_trial import MidpointTrials
 from orchestrator.model_info import model_info
+from orchestrator.run import run_scene
+from orchestrator.scenario import load_scene
 
 pytestmark = pytest.mark.skipif(
     not loader_plan().packs_loader, reason="no loader here: " + loader_plan().why_not
 )
 
+PROJECT = Path(__file__).resolve().parents[2]
 J, T_B, V0, T0, DT, H, STEPS = 0.05, 18.0, 5.0, 20.0, 3000.0, 1e-3, 20
 
 
@@ -148,3 +156,35 @@ def test_the_table_names_the_input_and_its_rate(fmu) -> None:
     table = zipfile.ZipFile(fmu).read(RAMPS_FILE).decode().splitlines()
     vr = {n: v.value_reference for n, v in info.variables.items()}
     assert table[1:] == [f"{vr['torque']} {vr['torque_rate']}"]
+
+
+def _press_feed(directory, monkeypatch=None):
+    """Press feed Run 2 over its first crank revolution (0.2 s: every kind of switch)."""
+    scene = load_scene(PROJECT / "scenarios" / "press_feed_run2.toml", {"scene.stop": "0.2 s"})
+    r = run_scene(scene, output_dir=directory, show_progress=False, plots=False)
+    assert r.status == "completed", r.message
+    return r, (directory / "events.csv").read_text().splitlines()[1:]
+
+
+@pytest.mark.slow
+def test_the_press_feed_through_the_standard_call(tmp_path, monkeypatch) -> None:
+    """The midpoint hold ramping the drive's and the brake's torque through
+    fmi2SetRealInputDerivatives (the torque at the step start and its slope) rather than
+    through their rate_of inputs (the torque's mean and its rate)."""
+    held, held_events = _press_feed(tmp_path / "rate_of")
+    monkeypatch.setattr(
+        capabilities,
+        "takes_input_derivative",
+        lambda model, name: model.can_interpolate_inputs and model.role_of(name) is None,
+    )
+    monkeypatch.setattr(MidpointTrials, "_rate_input", lambda self, j, name: None)
+    ramped, ramped_events = _press_feed(tmp_path / "standard")
+    assert ramped.stats.do_steps > 0 and held.stats.do_steps > 0
+    # The same switches, in the same order, at the same times up to the rounding of the
+    # mean: measured over the whole run (0.6 s), 1.3e-12 s and 3.5e-14 of the feed length.
+    assert [e.split(",")[1:] for e in ramped_events] == [e.split(",")[1:] for e in held_events]
+    for a, b in zip(ramped_events, held_events, strict=True):
+        assert float(a.split(",")[0]) == pytest.approx(float(b.split(",")[0]), abs=1e-10)
+    scale = np.abs(held.signal("load.feed_length")).max()
+    end = abs(ramped.signal("load.feed_length")[-1] - held.signal("load.feed_length")[-1])
+    assert end < 1e-10 * scale
