@@ -17,7 +17,7 @@ millionths).
 
 from __future__ import annotations
 
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 from orchestrator import capabilities
 from orchestrator.masters.switches import Readings
@@ -35,6 +35,14 @@ class HeldInput(NamedTuple):
     #: its FMU ramps it from its step-start value by the slope fmi2SetRealInputDerivatives
     #: gives (an FMU's own rate_of input is preferred where it has one)
     interpolated: bool = False
+
+
+class Slopes(NamedTuple):
+    """The inputs of one FMU it ramps by the slopes fmi2SetRealInputDerivatives gives."""
+
+    instance: int
+    indices: list[int]  # of the inputs in its instance's feed order
+    setter: Any  # sets their first derivatives
 
 
 class HeldInputs:
@@ -89,6 +97,21 @@ class HeldInputs:
                 if held.averaged
             }
         )
+
+    def interpolated_sources(self) -> list[Slot]:
+        """The sources of the inputs FMUs ramp by input derivatives, sorted."""
+        return sorted({h.source for inputs in self.inputs for h in inputs if h.interpolated})
+
+    def slopes(self) -> list[Slopes]:
+        """Per FMU that takes input derivatives, the inputs it ramps by them."""
+        found = []
+        for j, inputs in enumerate(self.inputs):
+            indices = [k for k, held in enumerate(inputs) if held.interpolated]
+            if indices:
+                inst = self.system.instances[j]
+                refs = inst.refs([inputs[k].name for k in indices])
+                found.append(Slopes(j, indices, inst.derivative_setter(refs)))
+        return found
 
     def change_ratio(self, before: Readings, signals: list[Slot], tolerance: float) -> float:
         """Held-input error relative to ``tolerance``: the largest change of the signals

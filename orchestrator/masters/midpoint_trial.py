@@ -66,14 +66,6 @@ class _Ramp(NamedTuple):
     setter: Any  # sets the instance's rate input
 
 
-class _Slopes(NamedTuple):
-    """The inputs of one FMU it ramps by the slopes fmi2SetRealInputDerivatives gives."""
-
-    instance: int
-    indices: list[int]  # of the inputs in its instance's feed order
-    setter: Any  # sets their first derivatives
-
-
 class MidpointTrials:
     """Predictor (and with the midpoint hold, corrector) trials; see the module doc."""
 
@@ -93,7 +85,7 @@ class MidpointTrials:
         self.midpoint = settings.midpoint
         self.held = HeldInputs(system)
         self.ramps = self._ramps() if self.midpoint else []
-        self.slopes = self._slopes() if self.midpoint else []
+        self.slopes = self.held.slopes() if self.midpoint else []
         #: the black-box signals whose change is the first-order error measure
         self.unsloped = self.held.unsloped if self.midpoint else self.held.unannotated
         self._ramps_set: dict[tuple[int, int], tuple[int, float]] = {}
@@ -315,17 +307,6 @@ class MidpointTrials:
                 if setter is not None:
                     ramps.append(_Ramp(j, k, setter))
         return ramps
-
-    def _slopes(self) -> list[_Slopes]:
-        """Per FMU that takes input derivatives, the inputs it ramps by them."""
-        slopes = []
-        for j, inputs in enumerate(self.held.inputs):
-            indices = [k for k, held in enumerate(inputs) if held.interpolated]
-            if indices:
-                inst = self.system.instances[j]
-                refs = inst.refs([inputs[k].name for k in indices])
-                slopes.append(_Slopes(j, indices, inst.derivative_setter(refs)))
-        return slopes
 
     def _rate_input(self, j: int, name: str) -> Any:
         """A setter of instance j's input with the role rate_of ``name``, None where it takes
