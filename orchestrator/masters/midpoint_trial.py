@@ -86,8 +86,6 @@ class MidpointTrials:
         self.held = HeldInputs(system)
         self.ramps = self._ramps() if self.midpoint else []
         self.slopes = self.held.slopes() if self.midpoint else []
-        #: the black-box signals whose change is the first-order error measure
-        self.unsloped = self.held.unsloped if self.midpoint else self.held.unannotated
         self._ramps_set: dict[tuple[int, int], tuple[int, float]] = {}
         #: FMU states the predictors of this macro step kept, freed at its end
         self._kept: list[list[Any]] = []
@@ -294,7 +292,8 @@ class MidpointTrials:
         held, tol = self.held, self.settings.tolerance
         if not self.midpoint:
             return Estimate(held.change_ratio(start.before, held.signals, tol), True)
-        unannotated = held.change_ratio(start.before, self.unsloped, tol) if self.unsloped else 0.0
+        # the black-box signals held through the step (not ramped by a slope)
+        unannotated = held.change_ratio(start.before, held.unsloped, tol) if held.unsloped else 0.0
         return Estimate(max(correction.ratio, unannotated), unannotated > correction.ratio)
 
     # -- ramped inputs -----------------------------------------------------------------
