@@ -27,14 +27,16 @@
  * serve) are the loader's: where the build wrote resources/input_derivatives.txt (the
  * value references of each input the component ramps and of its input with the role
  * rate_of it; the model description then says canInterpolateInputs="true"), a first
- * derivative du of input u set by the host means u(t) = u + du (t - tc) over the following
- * steps (tc: each step's start), until it is set again or the instance is reset.  The
- * component ramps its input about the step's middle, u_mid + rate (t - tc - h/2), so for
- * each step the loader sets u to u + du h/2 and the rate input to du, steps, and sets both
- * back to what they were: fmi2GetReal of the input gives the value the host set, and the
- * outputs that depend on it directly are computed with that value, as without a
- * derivative.  A derivative once set overrides the rate input for that input.  An FMU
- * state holds the derivatives set.  A derivative of the rate input itself, or of order 2
+ * derivative du of input u set by the host means u(t) = u + du (t - tc) over the next step
+ * (tc: its start, u: the input's value there).  The component ramps its input about the
+ * step's middle, u_mid + rate (t - tc - h/2), so the loader sets u to u + du h/2 and the
+ * rate input to du, steps, and then sets the input to where its ramp ends, u + du h (to u
+ * where the step was not taken), and the rate input back: after the step fmi2GetReal of
+ * the input gives its value at the step end, and the outputs that depend on it directly
+ * are computed with that value.  The derivative stays in force, the ramp going on from
+ * there, until it is set again or the instance is reset; a value set by fmi2SetReal starts
+ * the next ramp.  A derivative overrides the rate input for its input.  An FMU state
+ * holds the derivatives set.  A derivative of the rate input itself, or of order 2
  * or more, is accepted and not used (the component ramps to first order); of any other
  * variable, or of order 0, it is refused with fmi2Error.
  *
@@ -1026,7 +1028,17 @@ EXPORT fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint
     status = settle(i, runtime.fmi2DoStep(i->inner, currentCommunicationPoint,
                                           communicationStepSize,
                                           noSetFMUStatePriorToCurrentCommunicationPoint));
-    if (ramped > 0 && !i->failed) { /* the inputs as the host set them, whatever the step did */
+    if (ramped > 0 && !i->failed) {
+        /* each input where its ramp is at the step end (where the step was not taken:
+         * as set), each rate input as it was */
+        if (status == fmi2OK || status == fmi2Warning) {
+            size_t m = 0;
+            for (size_t k = 0; k < i->n_ramps; ++k) {
+                if (isnan(i->slope[k])) continue;
+                held[m] += i->slope[k] * communicationStepSize;
+                m += 2;
+            }
+        }
         fmi2Status back = settle(i, runtime.fmi2SetReal(i->inner, vrs, ramped, held));
         if (back > status) status = back;
     }

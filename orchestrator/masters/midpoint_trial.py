@@ -35,7 +35,7 @@ from dataclasses import dataclass
 from typing import Any, NamedTuple
 
 from orchestrator.master_settings import RegimeAwareSettings
-from orchestrator.masters.held_inputs import HeldInput, HeldInputs
+from orchestrator.masters.held_inputs import HeldInputs
 from orchestrator.masters.regime_aware import Estimate, RestartSteps, Trial
 from orchestrator.masters.switches import Landing, StepStart, Switch, back_to_start, switch_time
 from orchestrator.recorder import StepStats
@@ -91,8 +91,8 @@ class MidpointTrials:
         self._kept: list[list[Any]] = []
         control = settings.control
         self.restart = RestartSteps(settings.first_step, control.zero_error_restart, True)
-        sloped = {system.names[j] for j, _, _ in self.slopes}
-        held_boxes = [b for b in self.held.black_boxes if b not in sloped]
+        self.sloped = {j for j, _, _ in self.slopes}
+        held_boxes = [b for b in self.held.black_boxes if system.index[b] not in self.sloped]
         if held_boxes and self.midpoint:
             stats.extra.setdefault("warnings", []).append(
                 f"FMU {', '.join(map(repr, held_boxes))} declares no sampled "
@@ -218,14 +218,21 @@ class MidpointTrials:
         feeds, retake = [], []
         at_predictor = at is not None and (at.t, at.h) == (t, h) and at.states is not None
         for i, inputs in enumerate(self.held.inputs):
-            reals = [_corrector_input(held, values0, predicted) for held in inputs]
+            # At the step mean where averaged, else at the step-start value (one its FMU
+            # ramps by an input derivative, too: from there).
+            reals = [
+                0.5 * (values0[s][k] + predicted[s][k])
+                if averaged and not interpolated
+                else values0[s][k]
+                for (s, k), averaged, _, interpolated in inputs
+            ]
             feeds.append(reals)
             # An FMU whose held inputs the correction leaves as they were would retake
             # the predictor's very step: when it is at its end, it stays (a doStep fewer).
-            changed = not _same(reals, [values0[s][k] for (s, k), *_ in inputs]) or any(
-                predicted[s][k] != values0[s][k] for (s, k), _, _, sloped in inputs if sloped
-            )
-            if not (at_predictor and not changed):
+            same = _same(reals, [values0[s][k] for (s, k), *_ in inputs])
+            if same and i in self.sloped:  # and with no slope now
+                same = all(predicted[s][k] == values0[s][k] for (s, k), *_ in inputs)
+            if not (at_predictor and same):
                 retake.append(i)
         # Back to the step start, those that stay to the end of their predictor step.
         kept = at.states if at is not None else None
@@ -332,17 +339,6 @@ class MidpointTrials:
             if self._ramps_set.get((j, k)) != key:
                 setter([value])
                 self._ramps_set[(j, k)] = key
-
-
-def _corrector_input(
-    held: HeldInput, values0: list[list[float]], predicted: list[list[float]]
-) -> float:
-    """A held input's value on the corrector step: its step mean where averaged (unless
-    its FMU ramps it from the start by an input derivative), else its step-start value."""
-    s, k = held.source
-    if held.averaged and not held.interpolated:
-        return 0.5 * (values0[s][k] + predicted[s][k])
-    return values0[s][k]
 
 
 def _same(a: list[float], b: list[float]) -> bool:

@@ -84,7 +84,9 @@ def test_only_components_that_ramp_every_held_input_declare_it(fmu) -> None:
 
 def test_the_standard_call_and_the_rate_input_give_the_same_steps(fmu) -> None:
     by_rate, by_derivative = Brake(fmu, "by_rate"), Brake(fmu, "by_derivative")
+    once = Brake(fmu, "once")  # its torque set at the start only: the ramp goes on
     by_derivative.derivative("torque", DT)  # in force over every following step
+    once.derivative("torque", DT)
     worst = 0.0
     for n in range(STEPS):
         t0 = n * H
@@ -92,11 +94,16 @@ def test_the_standard_call_and_the_rate_input_give_the_same_steps(fmu) -> None:
         by_derivative.set(torque=T0 + DT * t0)
         by_rate.step()
         by_derivative.step()
+        once.step()
         (a, va), (b, vb) = by_rate.get("angle", "speed"), by_derivative.get("angle", "speed")
         worst = max(worst, abs(a - b) / abs(a), abs(va - vb) / abs(va))
-        # The input reads as set, and what depends on it directly is computed with it.
+        # The input reads as at the step end, and what depends on it directly is computed
+        # with that value.
         torque, breakaway = by_derivative.get("torque", "breakaway")
-        assert torque == T0 + DT * t0 and breakaway == abs(torque) - T_B
+        assert torque == (T0 + DT * t0) + DT * H and breakaway == abs(torque) - T_B
+        t = t0 + H
+        exact = V0 + ((T0 - T_B) * t + 0.5 * DT * t * t) / J
+        assert once.get("speed")[0] == pytest.approx(exact, rel=1e-13)
     t = STEPS * H
     exact = V0 + ((T0 - T_B) * t + 0.5 * DT * t * t) / J
     assert by_derivative.get("speed")[0] == pytest.approx(exact, rel=1e-13)
@@ -105,6 +112,7 @@ def test_the_standard_call_and_the_rate_input_give_the_same_steps(fmu) -> None:
     assert worst < 1e-14
     by_rate.close()
     by_derivative.close()
+    once.close()
 
 
 def test_a_saved_state_holds_the_derivative_and_a_reset_forgets_it(fmu) -> None:
