@@ -35,7 +35,6 @@ from pythonfmu.builder import FmuBuilder
 from components.base import Component
 from fmus.description import complete_description
 from fmus.documentation import render_documentation
-from fmus.example_scenes import ExampleSceneError
 from fmus.host_loader import LOADER_SOURCE, loader_binary, loader_plan, pack_loader
 from fmus.input_derivatives import declare_input_derivatives
 from fmus.registry import FMU_RECORDS, FmuRecord, RecordError
@@ -50,7 +49,6 @@ BUILD_CODE = (
     FMUS_DIR / "registry.py",
     FMUS_DIR / "description.py",
     FMUS_DIR / "documentation.py",
-    FMUS_DIR / "example_scenes.py",
     FMUS_DIR / "ports.py",
     FMUS_DIR / "units.py",
     FMUS_DIR / "host_loader.py",
@@ -76,7 +74,7 @@ def default_cache_dir() -> Path:
 
 def content_hash(record: FmuRecord) -> str:
     """Hash of everything that ends up in the FMU: its code and declarations, the build
-    code, pythonfmu, and how the example scenes couple it (not their values)."""
+    code and pythonfmu (no scene file: the example scenes are named, not read)."""
     h = hashlib.sha256()
     for f in record.modules():
         h.update(f"components/{f.name}".encode())
@@ -84,8 +82,6 @@ def content_hash(record: FmuRecord) -> str:
     for f in [record.script, *BUILD_CODE]:
         h.update(str(f.relative_to(PROJECT_DIR)).encode())
         h.update(f.read_bytes())
-    for example in record.examples():  # the documentation lists their connections
-        h.update(example.identity().encode())
     h.update(pythonfmu.__version__.encode())
     h.update(loader_plan().identity.encode())  # the compiler and the Python it names
     return h.hexdigest()
@@ -102,10 +98,7 @@ def build_fmu(name: str, cache_dir: Path | None = None, force: bool = False) -> 
         cache_dir.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise BuildError(f"cannot use {cache_dir} as the FMU cache: {exc}") from None
-    try:
-        digest = content_hash(record)[:16]
-    except ExampleSceneError as exc:
-        raise BuildError(str(exc)) from None
+    digest = content_hash(record)[:16]
     target = cache_dir / f"{name}-{digest}.fmu"
     if target.exists() and not force:
         return target

@@ -4,9 +4,9 @@
 external resources) from what the project already states once: the component's docstrings
 (which cite the source documents), its VARIABLES and PORTS tables, its regime names, and
 the FMU's record (``fmus.registry``): the wrapper script's description and default
-experiment, the requirements, and how the example scenes couple the FMU (their structure,
-not their values).  The page tells a user of another tool (FMPy, libcosim, a C/C++ master)
-what the FMU models, how to couple it, and what its host needs.
+experiment, the requirements, and the example scenes that couple the FMU (named, never
+read: an FMU depends on no scene file).  The page tells a user of another tool (FMPy,
+libcosim, a C/C++ master) what the FMU models, how to couple it, and what its host needs.
 """
 
 from __future__ import annotations
@@ -17,11 +17,9 @@ import shlex
 import sys
 import textwrap
 from html import escape
-from pathlib import Path
 
 from components.base import COMMON_OUTPUTS, Component
 from fmus.description import EVENT_TIME, INDICATOR_PREFIX, REGIME
-from fmus.example_scenes import ExampleScene
 from fmus.host_loader import RUNTIME_FILE, loader_binary, newest_version_needed, runtime_binary
 from fmus.input_derivatives import ramped_inputs
 from fmus.ports import PORT_RULE
@@ -48,7 +46,7 @@ def render_documentation(record: FmuRecord, loader: bool = True) -> str:
         ("ports", "Ports", _ports_section(component_class)),
         ("variables", "Variables", _variables_section(component_class)),
         ("regimes", "Regimes and events", _regimes_section(record)),
-        ("coupling", "How to couple it", _coupling_section(record, record.examples())),
+        ("coupling", "How to couple it", _coupling_section(record)),
         ("host", "Host requirements", _host_section(record, loader)),
         ("tools", "Usage in other tools", _tools_section(record)),
         ("capabilities", "FMI capabilities", _capabilities_section(record, loader)),
@@ -296,27 +294,30 @@ def _regimes_section(record: FmuRecord) -> str:
     return "".join(parts)
 
 
-def _coupling_section(record: FmuRecord, examples: list[ExampleScene]) -> str:
+def _coupling_section(record: FmuRecord) -> str:
     rule = (
         '<p>Ports connect by the rule of <a href="#ports">Ports</a>; a single signal '
         "connects one output to one input of the same type and unit (each input driven by "
         "one output at most).</p>\n"
     )
-    if not examples:
+    if not record.example_paths:
         return rule + (
             "<p>No scene of the project couples this FMU with another FMU (the scenes that "
             "use it run it alone): drive its inputs from any outputs of the same type and "
             'unit, or set them as start values (see <a href="#tools">Usage in other '
             "tools</a>).</p>\n"
         )
-    intro = (
-        "<p>The scenes below, from the project's <code>scenarios/</code>, are worked "
-        "couplings of this FMU, every connection spelled out variable by variable as "
-        "another tool needs it. The values each scene sets are in its file: a value with a "
-        "unit is converted to the SI unit of the variables table before it is set on the "
-        "FMU; a bare number is already SI.</p>\n"
+    scenes = "".join(f"<li><code>{escape(path)}</code></li>" for path in record.example_paths)
+    return rule + (
+        "<p>Worked couplings of this FMU with others are the project's scenes below: each "
+        "names its FMUs in <code>[fmus.&lt;instance&gt;]</code> tables and joins them in "
+        "<code>[[connections]]</code> (ports by the rule above, single signals as "
+        "<code>from</code> / <code>to</code>); <code>mechcosim export</code> spells "
+        "a scene out variable by variable for another tool. The values each scene sets are "
+        "in its file: a value with a unit is converted to the SI unit of the variables table "
+        "before it is set on the FMU; a bare number is already SI.</p>\n"
+        f'<ul class="examples">{scenes}</ul>\n'
     )
-    return rule + intro + "".join(_example_html(record, ex) for ex in examples)
 
 
 def _host_section(record: FmuRecord, loader: bool) -> str:
@@ -502,51 +503,6 @@ def _capabilities_section(record: FmuRecord, loader: bool) -> str:
         "<li>Outputs are valid in initialization mode: a master may read them there to set "
         "consistent inputs.</li>\n"
         "</ul>\n"
-    )
-
-
-# -- example scenes ---------------------------------------------------------------------------
-def _example_html(record: FmuRecord, ex: ExampleScene) -> str:
-    stem = Path(ex.path).stem
-    head = (
-        f"<h3>Scene <code>{escape(ex.path)}</code></h3>\n"
-        "<p>Its parameter values and master settings are in the scene file.</p>\n"
-    )
-    inst_rows = "".join(
-        f"<tr><td><code>{escape(inst)}</code></td><td><code>{escape(model)}</code>"
-        + (" (this FMU)" if model == record.name else "")
-        + "</td></tr>"
-        for inst, model in ex.instances
-    )
-    conn_rows = []
-    for n, c in enumerate(ex.connections, start=1):
-        integer = c.type == "Integer"
-        kind = (
-            '<strong class="integer">Integer</strong>: connect it as an Integer'
-            if integer
-            else "Real"
-        )
-        conn_rows.append(
-            f'<tr class="connection{" integer" if integer else ""}"><td class="num">{n}</td>'
-            f"<td><code>{escape('.'.join(c.source))} -&gt; {escape('.'.join(c.target))}</code>"
-            f"</td><td>{kind}</td><td>{escape(c.via)}</td></tr>"
-        )
-    n_int = sum(c.type == "Integer" for c in ex.connections)
-    int_note = (
-        f"<p>{n_int} of them {'is an Integer' if n_int == 1 else 'are Integers'}: an FMI tool "
-        "must connect it as an Integer (fmi2GetInteger / fmi2SetInteger; libcosimpy "
-        "<code>connect_integer_variables</code>), not as a Real.</p>\n"
-        if n_int
-        else ""
-    )
-    return (
-        head + '<table class="instances">\n<thead><tr><th>instance</th><th>FMU model</th></tr>'
-        f"</thead>\n<tbody>{inst_rows}</tbody>\n</table>\n"
-        f"<p>{len(ex.connections)} variable-level connections (output -&gt; input):</p>\n"
-        f'<table id="connections-{escape(stem)}" class="connections">\n'
-        "<thead><tr><th>#</th><th>connection</th><th>type</th><th>from scene entry</th></tr>"
-        f"</thead>\n<tbody>\n{chr(10).join(conn_rows)}\n</tbody>\n</table>\n"
-        f"{int_note}"
     )
 
 

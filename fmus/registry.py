@@ -14,14 +14,13 @@ from __future__ import annotations
 
 import ast
 import sys
-from collections.abc import Iterator, Mapping
+from collections.abc import Mapping
 from dataclasses import dataclass
 from functools import cache, cached_property
 from importlib import import_module
 from pathlib import Path
 
 from components.base import Component, Variable
-from fmus.example_scenes import ExampleScene, read_example_scene
 
 FMUS_DIR = Path(__file__).resolve().parent
 PROJECT_DIR = FMUS_DIR.parent
@@ -39,7 +38,7 @@ _SLAVE_KEYS = {
 
 class RecordError(ValueError):
     """A wrapper script or what it names cannot make a record (a missing key, an unknown
-    requirement, a broken example scene)."""
+    requirement)."""
 
 
 @dataclass(frozen=True)
@@ -50,7 +49,7 @@ class FmuRecord:
     description: str
     default_run: tuple[float, float, float]  # (start, stop, step) of `fmpy simulate` alone
     #: Scenes (paths relative to the project root) that couple this FMU with others; the
-    #: FMU's documentation lists their connections.
+    #: FMU's documentation names them (never reads them: an FMU depends on no scene file).
     example_paths: tuple[str, ...] = ()
 
     @cached_property
@@ -74,39 +73,6 @@ class FmuRecord:
     def requirements(self) -> list[str]:
         """Requirement lines for the third-party modules the packed code imports."""
         return requirements(self.modules())
-
-    def examples(self) -> list[ExampleScene]:
-        """The example scenes, read now (an edit is seen at once)."""
-        examples = []
-        for path in self.example_paths:
-            try:
-                stat = (PROJECT_DIR / path).stat()
-                version = (stat.st_mtime_ns, stat.st_size)
-            except OSError:
-                version = (0, 0)  # missing: read_example_scene says so
-            examples.append(_example(path, self.name, *version))
-        return examples
-
-
-@cache
-def _example(path: str, fmu: str, mtime_ns: int, size: int) -> ExampleScene:
-    """An example scene, kept per file version (its modification time and size): reading
-    and expanding them again cost 2 ms of every M739 scene load."""
-    return read_example_scene(PROJECT_DIR, path, fmu, _ComponentClasses())
-
-
-class _ComponentClasses(Mapping[str, type[Component]]):
-    """FMU name -> component class, each imported when first asked for (an example scene
-    imports only the components it holds)."""
-
-    def __getitem__(self, name: str) -> type[Component]:
-        return FMU_RECORDS[name].component_class
-
-    def __iter__(self) -> Iterator[str]:
-        return iter(FMU_RECORDS)
-
-    def __len__(self) -> int:
-        return len(FMU_RECORDS)
 
 
 def component_modules(component: str) -> list[Path]:

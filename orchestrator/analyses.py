@@ -10,7 +10,7 @@ from typing import Any
 
 import numpy as np
 
-from orchestrator.scenario import Scene
+from orchestrator.scene_model import Scene
 from orchestrator.scenes.family import Quantity, quantity
 
 _REDUCE: dict[str, Callable[[np.ndarray], float]] = {

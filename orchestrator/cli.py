@@ -199,7 +199,8 @@ def main(argv: list[str] | None = None) -> int:
 
     p = sub.add_parser(
         "report",
-        help="print what a run printed as it ended (completed, failed, interrupted or crashed)",
+        help="print what a run printed as it ended (completed, failed, interrupted or "
+        "crashed), or how far a run in progress or killed got",
     )
     p.add_argument("run_dir", type=Path, help="the run's results directory (its summary.json)")
     p.add_argument("--json", action="store_true", help="the summary as JSON instead")
@@ -442,10 +443,14 @@ def _export(args: argparse.Namespace) -> int:
     if args.osp is not None and args.osp.exists() and not args.osp.is_dir():
         print(f"error: --osp {args.osp}: is a file; expected a directory", file=sys.stderr)
         return 2
-    from orchestrator.export_target import check_export_target
+    from orchestrator.export_target import check_export_target, check_not_read
 
     check_export_target(args.scene, args.out, args.force)
     scene = load_scene(args.scene, _overrides(args.set))
+    check_not_read(scene, args.out)
+    if args.osp is not None:  # it writes <instance>.fmu there
+        for name, spec in scene.fmus.items():
+            check_not_read(scene, args.osp / f"{name}.fmu", "--osp", copy_of=spec.path)
     if args.osp is not None:  # first: it carries input signals, which SSP refuses
         print(f"{export_osp(scene, args.osp)}: the FMUs beside it")
     out = export_ssp(scene, args.out)
@@ -508,9 +513,10 @@ def _precision(args: argparse.Namespace) -> int:
     for master in dict.fromkeys(r.master for r in rows):
         line = f"  {master:22s} observed order {observed_order(rows, master):.2f}"
         ratios = [r.monolithic_ratio for r in rows if r.master == master]
-        ratios = [x for x in ratios if not math.isnan(x)]  # those in the turns-error window
+        ratios = [x for x in ratios if not math.isnan(x)]  # those in the error window
         if ratios:
-            line += f", x monolithic at the same turns error {min(ratios):.2f}..{max(ratios):.2f}"
+            word = rows[0].headline.word  # what the family's headline quantity counts
+            line += f", x monolithic at the same {word} error {min(ratios):.2f}..{max(ratios):.2f}"
         print(line)
     out = Path(rows[0].result.job.output_dir).parent if rows else args.output
     print(f"report in {out}/work_precision.md (.csv, .png)")
@@ -640,17 +646,12 @@ def _animate(args: argparse.Namespace) -> int:
 
 
 def _report(args: argparse.Namespace) -> int:
-    summary_file = args.run_dir / "summary.json"
-    if not summary_file.exists():
-        print(f"error: {summary_file} not found: not a run directory", file=sys.stderr)
-        return 2
+    from orchestrator.run_state import run_summary
+
     try:
-        summary = json.loads(summary_file.read_bytes().decode("utf-8"))
-    except (ValueError, UnicodeDecodeError) as exc:
-        print(f"error: {summary_file} is not a readable summary: {exc}", file=sys.stderr)
-        return 2
-    if not isinstance(summary, dict) or not isinstance(summary.get("status"), str):
-        print(f"error: {summary_file} is not a run summary (no status)", file=sys.stderr)
+        summary = run_summary(args.run_dir)
+    except RunError as exc:
+        print(f"error: {exc}", file=sys.stderr)
         return 2
     if args.json:
         print(json.dumps(summary, indent=2))

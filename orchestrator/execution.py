@@ -1,33 +1,24 @@
-"""The execution loop every master shares: macro steps until the run ends.
+"""The execution loop every master shares: macro steps until the stop rule ends the run.
 
-The master (orchestrator/masters/) only steps; this loop decides when the run ends (the
-scene's stop time, or its ``stop_when`` condition after the step that meets it), hands each
-step to the observers (orchestrator/observers.py), reports progress, and on an
-interruption keeps the values at the step boundary reached.
+The master (orchestrator/masters/) only steps; the stop rule says when the run ends (its
+stop time, or its ``stop_when`` condition after the step that meets it); the observers
+(orchestrator/observers.py: the time series, the regime log, the step counter, the energy
+balance, any other) are told the start and every step, all alike.  The loop reports
+progress and, on an interruption, tells the observers where the run stopped.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from typing import Protocol
+from dataclasses import dataclass
 
 from orchestrator.interrupt import Interrupted
-from orchestrator.masters import MASTERS, MacroStep
-from orchestrator.observers import RegimeLog, StepCounter, TimeSeries
-from orchestrator.recorder import Recorder, StepStats
-from orchestrator.scenario import Scene
+from orchestrator.masters.macro_step import Master
+from orchestrator.observers import Observer, regime_changes
 from orchestrator.system import CoupledSystem
 
 #: relative: a run this close to its stop time has reached it
 STOP_SLACK = 1e-15
-
-
-class Observer(Protocol):
-    """What else watches a run: told the start and every step, after the record."""
-
-    def start(self, t: float) -> None: ...
-
-    def step(self, step: MacroStep) -> None: ...
 
 
 def end_time(stop: float) -> float:
@@ -41,37 +32,45 @@ def condition_met(system: CoupledSystem) -> bool:
     return indicator is not None and indicator <= 0.0
 
 
+@dataclass(frozen=True)
+class StopRule:
+    """When a run ends: at ``stop``, or after the step that meets the system's stop
+    condition (the scene's ``stop_when``, if any)."""
+
+    start: float
+    stop: float
+    system: CoupledSystem
+
+    def met(self) -> bool:
+        return condition_met(self.system)
+
+
 def execute(
-    system: CoupledSystem,
-    scene: Scene,
-    recorder: Recorder,
-    stats: StepStats,
+    master: Master,
+    rule: StopRule,
+    observers: Sequence[Observer],
     progress: Callable[[float], None],
-    observers: Sequence[Observer] = (),
 ) -> None:
-    """Run the scene's master over its span on an initialized ``system``.
+    """Run ``master`` (set up and started on an initialized system) from the rule's start
+    until it says stop.
 
     ``progress(t)`` is called after every step, between FMU calls: it may raise
-    ``Interrupted``, and the run then ends with the values at t recorded.  ``observers``
-    are told the start and every step besides the record, the regime log and the counts."""
-    master = MASTERS[scene.master.algorithm](system, scene, stats)
-    series = TimeSeries(system, recorder, scene.record_every)
-    log = RegimeLog(system, recorder)
-    counter = StepCounter(stats)
-    t, stop = scene.start, scene.stop
+    ``Interrupted``, and the observers are then told where the run stopped."""
+    system = master.system
+    t, stop = rule.start, rule.stop
     end = end_time(stop)
-    series.start(t)
     for observer in observers:
         observer.start(t)
-    count = 0
+    regimes = system.regimes()
     while t < end:
         step = master.step(t, stop)
         t = step.end
-        count += 1
-        logged = log.update(t if step.changes_at is None else step.changes_at, step.regimes_before)
-        counter.step(step, logged)
-        done = condition_met(system)
-        series.step(count, step, last=done or t >= end)
+        now = system.regimes()
+        before = regimes if step.regimes_before is None else step.regimes_before
+        step.changes = regime_changes(system, before, now)
+        regimes = now
+        done = rule.met()
+        step.last = done or t >= end
         for observer in observers:
             observer.step(step)
         if step.failure is not None:
@@ -79,8 +78,9 @@ def execute(
         try:
             progress(t)
         except Interrupted:
-            series.keep(t)
+            for observer in observers:
+                observer.interrupted(t)
             raise
         if done:  # the step that met the condition is the last
-            stats.extra["stopped_by_condition"] = True
+            master.stats.stopped_by_condition = True
             return

@@ -30,6 +30,7 @@ from fmpy.fmi2 import (  # the allocators fmpy itself hands to FMUs, and its val
     fmi2CallbackLoggerTYPE,
     fmi2FMUstate,
     fmi2Integer,
+    fmi2LastSuccessfulTime,
     fmi2Real,
     fmi2Terminated,
     fmi2True,
@@ -54,9 +55,12 @@ DISCARD = 2
 class FmuTerminated(RunError):
     """An FMU asked to end the simulation: the run ends there, completed."""
 
-    def __init__(self, message: str, time: float, fmu: str) -> None:
+    def __init__(self, message: str, time: float, fmu: str, last_time: float | None = None) -> None:
         RuntimeError.__init__(self, message)  # the message names FMU and time itself
         self.time, self.fmu = time, fmu
+        # fmi2LastSuccessfulTime, where the FMU got to within the step it ended (None: it
+        # did not say, or said the step start): FMPy records its outputs there.
+        self.last_time = last_time
 
 
 class FmiCallError(RunError):
@@ -238,10 +242,22 @@ class FmuInstance:
             self._alive = False
             said = self.said_since(logged) or f"fmi2DoStep returned {STATUS_NAMES[exc.status]}"
             if exc.status == DISCARD and self._asks_to_terminate():
+                last = self._last_successful_time(t, h)
+                at = f"t = {t:.9g} s" if last is None else f"t = {last:.9g} s (last successful)"
                 raise FmuTerminated(
-                    f"terminated by FMU {self.name!r} at t = {t:.9g} s: {said}", t, self.name
+                    f"terminated by FMU {self.name!r} at {at}: {said}", t, self.name, last
                 ) from None
             raise RunError(f"doStep failed: {said}", t, self.name) from None
+
+    def _last_successful_time(self, t: float, h: float) -> float | None:
+        """fmi2GetRealStatus(fmi2LastSuccessfulTime) after a step that ended the run, if
+        it lies past the step start (beyond round-off) and within the step."""
+        try:
+            last = float(self.fmu.getRealStatus(fmi2LastSuccessfulTime))
+        except Exception:  # noqa: BLE001 - the FMU cannot say (fmi2Discard, no function)
+            return None
+        slack = 1e-9 * h  # the FMU's own sum of its steps differs from ours in the last bits
+        return min(last, t + h) if t + slack < last <= t + h + slack else None
 
     def _asks_to_terminate(self) -> bool:
         """fmi2GetBooleanStatus(fmi2Terminated) after a doStep that returned fmi2Discard:

@@ -20,13 +20,16 @@ import dataclasses
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any, ClassVar
+from typing import Any, ClassVar, Protocol
 
-#: Keys every master has; the others are its step (STEP_KEYS) and fields of its settings.
+#: Keys every master has; the others are its step (its settings' STEP_KEY) and fields of
+#: its settings.
 COMMON_KEYS = ("algorithm", "order")
 #: The smallest master.tolerance taken: relative coupling errors of 1e-12 over steps of
 #: 1e-14 s (master.min_step's default) are already near double precision's 2.2e-16.
 MIN_TOLERANCE = 1e-12
+#: The largest: an error as large as the quantity itself controls nothing.
+MAX_TOLERANCE = 1.0
 #: Settings where 0 means "none" rather than being out of range.
 OFF_AT_ZERO = ("call_timeout",)
 #: How long one FMI call may take before the run's supervisor ends it [s] (README, "A
@@ -59,8 +62,28 @@ def setting(default: Any, unit: str | None = None, choices: tuple[str, ...] = ()
     return field(default=default, metadata={"kind": SettingKind(unit, choices)})
 
 
-def _kinds(cls: type) -> dict[str, SettingKind]:
+def kinds_of(cls: type) -> dict[str, SettingKind]:
     return {f.name: f.metadata["kind"] for f in dataclasses.fields(cls) if "kind" in f.metadata}
+
+
+class Settings(Protocol):
+    """What every master's settings are: a frozen dataclass read from the scene."""
+
+    STEP_KEY: ClassVar[str]  # the key the master reads its step from
+    call_timeout: float  # read by the run's supervisor
+
+    @classmethod
+    def from_options(
+        cls, step: float, duration: float, options: dict[str, Any], fixed_step: float
+    ) -> Settings:
+        """The settings of a scene: its step (its own key, else the one it lends), the run's
+        duration, the options read_options gives, and the fixed step (master.step, else
+        the step the scene gives)."""
+
+
+def as_record(settings: Any) -> dict[str, Any]:
+    """Every field of ``settings`` as it ran, nested controls included (for the summary)."""
+    return dataclasses.asdict(settings)
 
 
 @dataclass(frozen=True)
@@ -72,8 +95,10 @@ class FixedStepSettings:
     call_timeout: float = setting(CALL_TIMEOUT, "s")  # 0: no limit (read by the supervisor)
 
     @classmethod
-    def from_options(cls, step: float, duration: float, options: dict[str, Any]):
-        return cls(step, **{k: v for k, v in options.items() if k in _kinds(cls)})
+    def from_options(
+        cls, step: float, duration: float, options: dict[str, Any], fixed_step: float = 0.0
+    ) -> FixedStepSettings:
+        return cls(step, **{k: v for k, v in options.items() if k in kinds_of(cls)})
 
 
 @dataclass(frozen=True)
@@ -154,6 +179,9 @@ class RegimeAwareSettings:
     control: MasterStepControl = MasterStepControl()
     single_pass_control: SinglePassControl = SinglePassControl()
     run_duration: float = math.inf  # not a scene key: the run's length (longest_step)
+    #: not a scene key: the macro step of the Jacobi run where rollbacks are impossible
+    #: (master.step, else first_step)
+    fixed_step: float = 0.0
 
     @property
     def midpoint(self) -> bool:
@@ -174,22 +202,42 @@ class RegimeAwareSettings:
             return self.run_duration
         return min(100.0 * self.first_step, self.run_duration)
 
+    def jacobi(self) -> FixedStepSettings:
+        """The fixed-step Jacobi run instead where the FMUs cannot be rolled back."""
+        return FixedStepSettings(self.fixed_step, self.call_timeout)
+
+    def jacobi_words(self) -> str:
+        """That Jacobi run, in words."""
+        return (
+            f"fixed-step Jacobi in steps of {self.fixed_step:g} s (no error control, switches "
+            "seen only at communication points)"
+        )
+
     @property
     def single_pass(self) -> bool:
         """One pass per macro step with extrapolated inputs (masters/single_pass.py)."""
         return self.input_hold == "extrapolated"
 
     @classmethod
-    def from_options(cls, step: float, duration: float, options: dict[str, Any]):
+    def from_options(
+        cls, step: float, duration: float, options: dict[str, Any], fixed_step: float = 0.0
+    ) -> RegimeAwareSettings:
         """The settings of a scene: ``options`` as read_options gives them, the rest
         defaults."""
-        values = {k: v for k, v in options.items() if k in _kinds(cls)}
-        settings = cls(first_step=step, run_duration=duration, **values)
+        values = {k: v for k, v in options.items() if k in kinds_of(cls)}
+        fixed = fixed_step or step
+        settings = cls(first_step=step, run_duration=duration, fixed_step=fixed, **values)
         if settings.tolerance < MIN_TOLERANCE:
             raise SettingError(
                 "tolerance",
                 f"must be at least {MIN_TOLERANCE:g} (a smaller one asks for steps below the "
                 f"resolution of the time in double precision), got {settings.tolerance:g}",
+            )
+        if settings.tolerance > MAX_TOLERANCE:
+            raise SettingError(
+                "tolerance",
+                f"must be at most {MAX_TOLERANCE:g} (an error as large as the quantity "
+                f"controls nothing), got {settings.tolerance:g}",
             )
         if "min_step" in options and settings.min_step > step:
             raise SettingError(
@@ -198,33 +246,19 @@ class RegimeAwareSettings:
         return settings
 
 
-#: Every master's settings, by the name a scene gives its algorithm.
-SETTINGS: dict[str, type] = {
-    "jacobi": FixedStepSettings,
-    "gauss-seidel": FixedStepSettings,
-    "regime-aware": RegimeAwareSettings,
-}
-ALGORITHMS = tuple(SETTINGS)
-#: The keys the masters read their step from (see the module docstring).
-STEP_KEYS = tuple(dict.fromkeys(cls.STEP_KEY for cls in SETTINGS.values()))
-#: Masters whose accuracy is set by master.tolerance rather than by the macro step.
-TOLERANCE_MASTERS = tuple(a for a, cls in SETTINGS.items() if "tolerance" in _kinds(cls))
-#: Every key a scene's [master] table may hold beyond COMMON_KEYS, with its kind.
-SETTING_KINDS: dict[str, SettingKind] = {
-    k: v for cls in dict.fromkeys(SETTINGS.values()) for k, v in _kinds(cls).items()
-}
-
-MasterSettings = FixedStepSettings | RegimeAwareSettings
-
-
-def read_options(node: dict[str, Any], to_si: Callable[[Any, str, str], float]) -> dict[str, Any]:
-    """The settings a scene's [master] table writes, checked and in SI.
+def read_options(
+    node: dict[str, Any],
+    to_si: Callable[[Any, str, str], float],
+    kinds: dict[str, SettingKind],
+) -> dict[str, Any]:
+    """The settings a scene's [master] table writes, checked and in SI: those of ``kinds``
+    (every master's, orchestrator/masters/registry.py).
 
     ``to_si(raw, key, unit)`` converts a quantity (and reports a bad one itself); a value
     of the wrong kind or out of range raises SettingError.
     """
     options: dict[str, Any] = {}
-    for k, kind in SETTING_KINDS.items():
+    for k, kind in kinds.items():
         if k not in node:
             continue
         raw = node[k]
@@ -248,15 +282,3 @@ def read_options(node: dict[str, Any], to_si: Callable[[Any, str, str], float]) 
     if low is not None and high is not None and high < low:
         raise SettingError("max_step", f"{high:g} s is less than master.min_step ({low:g} s)")
     return options
-
-
-def step_key(algorithm: str) -> str:
-    """The key ``algorithm`` reads its step from (its settings' STEP_KEY)."""
-    return SETTINGS[algorithm].STEP_KEY
-
-
-def master_settings(
-    algorithm: str, step: float, duration: float, options: dict[str, Any]
-) -> MasterSettings:
-    """The typed settings of ``algorithm`` (raises SettingError on a value out of range)."""
-    return SETTINGS[algorithm].from_options(step, duration, options)

@@ -1,21 +1,32 @@
-"""Observers of a run: what the execution loop records after each macro step.
+"""Observers of a run: what the execution loop tells the start and every macro step.
 
 The time series (every n-th step, ``output.every``), the regime log (events), the step
-statistics and the energy balance (over every step, the series thinned or not).  They
-read the system and write through the ``Recorder``; none of them changes the system, so
-what a master computes does not depend on what is recorded.
+statistics and the energy balance (over every step, the series thinned or not) are equals:
+each follows ``Observer``.  They read the system and write through the ``Recorder``; none
+of them changes the system, so what a master computes does not depend on what is recorded.
 """
 
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Protocol
 
 from orchestrator.errors import RunError
 from orchestrator.recorder import Recorder, StepStats
 
 if TYPE_CHECKING:  # the masters import regime_changes from here
     from orchestrator.masters.macro_step import MacroStep
+
+
+class Observer(Protocol):
+    """What watches a run: told the start, every step (the loop has filled in its regime
+    changes and whether it is the last) and where an interrupted run stopped."""
+
+    def start(self, t: float) -> None: ...
+
+    def step(self, step: MacroStep) -> None: ...
+
+    def interrupted(self, t: float) -> None: ...
 
 
 def regime_changes(
@@ -35,21 +46,23 @@ class RegimeLog:
     """Logs every change of an FMU's ``regime`` output as an event (time, FMU, from, to).
 
     A fixed-step master sees a switch only at the end of the step it happened in, so the
-    logged time is that communication point, not the switching instant.
+    logged time is that communication point, not the switching instant; a regime-aware
+    step that changed a regime without a located switch logs it at its start.
     """
 
-    def __init__(self, system: Any, recorder: Recorder) -> None:
-        self.system, self.recorder = system, recorder
-        self.last = system.regimes()
+    def __init__(self, recorder: Recorder) -> None:
+        self.recorder = recorder
 
-    def update(self, t: float, before: list[int | None] | None = None) -> int:
-        """Log the changes since ``before`` (default: the regimes last seen) at ``t``."""
-        now = self.system.regimes()
-        changes = regime_changes(self.system, self.last if before is None else before, now)
-        for name, a, b in changes:
+    def start(self, t: float) -> None:
+        pass
+
+    def step(self, step: MacroStep) -> None:
+        t = step.end if step.changes_at is None else step.changes_at
+        for name, a, b in step.changes:
             self.recorder.event(t, name, a, b)
-        self.last = now
-        return len(changes)
+
+    def interrupted(self, t: float) -> None:
+        pass
 
 
 class TimeSeries:
@@ -58,20 +71,20 @@ class TimeSeries:
 
     def __init__(self, system: Any, recorder: Recorder, every: int) -> None:
         self.system, self.recorder, self.every = system, recorder, every
+        self.count = 0  # steps seen
 
     def start(self, t: float) -> None:
         self.recorder.row(self.system.record_row(t))
 
-    def step(self, count: int, step: MacroStep, last: bool) -> None:
-        """After the ``count``-th step (from 1); ``last``: the run ends with it."""
-        if count % self.every == 0 or last or step.record:
+    def step(self, step: MacroStep) -> None:
+        self.count += 1
+        if self.count % self.every == 0 or step.last or step.record:
             if step.left_row is not None:
                 self.recorder.row(step.left_row)
             self.recorder.row(self.system.record_row(step.end))
 
-    def keep(self, t: float) -> None:
-        """The run stops at t (interrupted): record the values there if a thinned record
-        lacks them."""
+    def interrupted(self, t: float) -> None:
+        """The run stops at t: record the values there if a thinned record lacks them."""
         rows = self.recorder.rows
         if rows and rows[-1][0] < t:
             try:
@@ -81,14 +94,21 @@ class TimeSeries:
 
 
 class StepCounter:
-    """Counts the accepted steps and the switches into the run's ``StepStats``."""
+    """Counts the accepted steps and the switches into the master's ``StepStats``."""
 
     def __init__(self, stats: StepStats) -> None:
         self.stats = stats
 
-    def step(self, step: MacroStep, logged: int) -> None:
+    def start(self, t: float) -> None:
+        pass
+
+    def step(self, step: MacroStep) -> None:
+        logged = len(step.changes)
         self.stats.steps += 1
         self.stats.events += max(logged, 1) if step.switched else logged
+
+    def interrupted(self, t: float) -> None:
+        pass
 
 
 class EnergyBalance:
@@ -147,6 +167,9 @@ class EnergyBalance:
         drift = abs(total - self.first)
         self.finite = self.finite and math.isfinite(drift)
         self.drift = max(self.drift, drift)
+
+    def interrupted(self, t: float) -> None:
+        pass
 
     def residual(self) -> dict[str, Any] | None:
         """The residual as a headline quantity; None without a balance or a scale."""

@@ -20,7 +20,7 @@ import xml.etree.ElementTree as ET
 from pathlib import Path
 
 from orchestrator.run import fmu_files
-from orchestrator.scenario import Scene
+from orchestrator.scene_model import Scene
 from orchestrator.signals import libcosim_scenario
 from orchestrator.ssp_export import libcosim_step
 

@@ -1,8 +1,9 @@
 """A run owns its results directory: a lock file, so two runs never write into one.
 
 The lock is an advisory ``flock`` on ``<directory>/.mechcosim.lock``, which also holds the
-owner's process id and host for the message.  The operating system drops the lock when its
-process ends, however it ends, so a lock file left by a dead run is simply taken over.
+owner's process id and host for the message, and what the run is (its scene).  The
+operating system drops the lock when its process ends, however it ends, so a lock file
+left by a dead run is simply taken over.
 """
 
 from __future__ import annotations
@@ -27,8 +28,11 @@ class OutputInUseError(RunError):
 class OutputLock:
     """Hold ``directory`` for one run: ``acquire`` (creates the directory) and ``release``."""
 
-    def __init__(self, directory: Path) -> None:
+    def __init__(self, directory: Path, about: dict | None = None) -> None:
         self.directory = Path(directory)
+        # What the run is (its scene): kept in the lock file, which a killed run leaves
+        # behind, for ``mechcosim report`` (orchestrator.run_state).
+        self.about = dict(about or {})
         self.path = self.directory / LOCK_NAME
         self._fd: int | None = None
 
@@ -60,7 +64,12 @@ class OutputLock:
             if not same:
                 os.close(fd)
                 continue
-            owner = {"pid": os.getpid(), "host": socket.gethostname(), "since": time.time()}
+            owner = {
+                "pid": os.getpid(),
+                "host": socket.gethostname(),
+                "since": time.time(),
+                **self.about,
+            }
             os.ftruncate(fd, 0)
             os.write(fd, json.dumps(owner).encode())
             self._fd = fd

@@ -21,7 +21,8 @@ from orchestrator.errors import RunError
 
 @dataclass
 class StepStats:
-    """Counters every master keeps."""
+    """Counters every master keeps; a master with statistics of its own keeps them in a
+    subclass (``masters.regime_aware.RegimeAwareStats``)."""
 
     steps: int = 0  # accepted macro steps
     do_steps: int = 0  # FMU doStep calls, all instances
@@ -30,12 +31,31 @@ class StepStats:
     iterations: int = 0  # coupling iterations beyond the first pass
     events: int = 0  # located regime switches
     wall_time: float = 0.0  # seconds, whole run
-    extra: dict[str, Any] = field(default_factory=dict)
+    warnings: list[str] = field(default_factory=list)  # what the master gave up, and why
+    stopped_by_condition: bool = False  # the scene's stop_when ended the run
 
     def as_dict(self) -> dict[str, Any]:
-        d = {k: v for k, v in self.__dict__.items() if k != "extra"}
-        d.update(self.extra)
+        """The summary's "stats": the counters, then what the master chose, its warnings,
+        its own counts (those that are not zero) and the stop by a condition."""
+        d: dict[str, Any] = {k: getattr(self, k) for k in _COUNTERS}
+        d.update(self.choices())
+        if self.warnings:
+            d["warnings"] = list(self.warnings)
+        d.update(self.counts())
+        if self.stopped_by_condition:
+            d["stopped_by_condition"] = True
         return d
+
+    def choices(self) -> dict[str, Any]:
+        """What the master chose as it started (none here)."""
+        return {}
+
+    def counts(self) -> dict[str, Any]:
+        """The master's own counts (none here)."""
+        return {}
+
+
+_COUNTERS = ("steps", "do_steps", "rejections", "rollbacks", "iterations", "events", "wall_time")
 
 
 class Recorder:

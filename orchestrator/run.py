@@ -24,23 +24,27 @@ from fmus.build import build_fmu, default_cache_dir
 from orchestrator.accuracy import compare
 from orchestrator.analyses import energy_residual, headline, missing_column
 from orchestrator.errors import RunError
-from orchestrator.execution import execute
+from orchestrator.execution import StopRule, execute
 from orchestrator.flight import announce_run, summary_written
 from orchestrator.fmu_instance import FmuTerminated, file_sha256
 from orchestrator.fmu_log import FmuLog
 from orchestrator.interrupt import Interrupted, SignalGuard, catching_signals, signal_name
-from orchestrator.masters.regime_aware_choice import fmu_tolerance
-from orchestrator.observers import EnergyBalance
+from orchestrator.last_success import record_last_success
+from orchestrator.master_settings import as_record
+from orchestrator.masters.macro_step import Master
+from orchestrator.masters.registry import algorithm
+from orchestrator.observers import EnergyBalance, RegimeLog, StepCounter, TimeSeries
 from orchestrator.output_lock import OutputLock
 from orchestrator.plotting import pyplot
 from orchestrator.progress import ProgressBar
 from orchestrator.provenance import source_commit
 from orchestrator.recorder import Recorder, StepStats
 from orchestrator.reference_cache import cached_reference
-from orchestrator.scenario import Scene
+from orchestrator.scene_model import Scene
 from orchestrator.scenes import ANALYSES, PLOTS, REFERENCES
 from orchestrator.scenes.family import Reference
 from orchestrator.signals import scene_signals
+from orchestrator.stop_condition import keep_comparable, refuse_if_met_at_start
 from orchestrator.summary_file import not_started_summary, write_summary
 from orchestrator.system import CoupledSystem
 
@@ -91,7 +95,8 @@ def run_scene(
     """
     out = Path(output_dir) if output_dir else scene.output_dir
     options = _Options(compare_reference, plots, cache_dir, reference_cache, Phases())
-    with catching_signals() as guard, OutputLock(out):
+    about = {"scene": scene.name, "scene_file": str(scene.path), "stop": scene.stop}
+    with catching_signals() as guard, OutputLock(out, about):
         announce_run(scene, out)  # for a supervisor, should this process crash
         return _run_locked(scene, out, cache_dir, show_progress, options, guard)
 
@@ -138,7 +143,9 @@ def _run_locked(
     except OSError as exc:
         system.close()
         raise RunError(f"cannot write results in {out}: {exc.strerror or exc}") from None
-    stats = StepStats()
+    # The master says what it needs of the FMUs before they are initialized.
+    master = algorithm(scene.master.algorithm).make(scene.master.settings, system)
+    master.setup()
     energy = EnergyBalance(system, recorder.header)
     with phases.timed("metadata (FMU hashes, versions, commit)"):
         meta = _metadata(scene, fmu_paths)
@@ -163,7 +170,7 @@ def _run_locked(
 
     start = time.perf_counter()
     try:
-        return _stepped(scene, out, system, recorder, stats, energy, meta, guard, progress,
+        return _stepped(scene, out, master, recorder, energy, meta, guard, progress,
                         reached, bar, start, options)  # fmt: skip
     finally:
         # Last: an FMU that crashes as it is terminated or freed (README, "A crashing FMU")
@@ -175,9 +182,8 @@ def _run_locked(
 def _stepped(
     scene: Scene,
     out: Path,
-    system: CoupledSystem,
+    master: Master,
     recorder: Recorder,
-    stats: StepStats,
     energy: EnergyBalance,
     meta: dict[str, Any],
     guard: SignalGuard,
@@ -190,19 +196,31 @@ def _stepped(
     """Step ``system`` to the end, then analyse, summarize and return the run (the FMUs
     stay alive: the caller closes them)."""
     status, message = "completed", ""
-    notes: list[str] = []
+    # a signal file read in FMPy's format, without units: said where the run is reported
+    signals = meta.get("signals", {})
+    notes = [f"signal {k}: {v['units']}" for k, v in signals.items() if "units" in v]
     phases = options.phases
+    system, stats = master.system, master.stats
+    observers = [
+        RegimeLog(recorder),
+        StepCounter(stats),
+        TimeSeries(system, recorder, scene.record_every),
+        energy,
+    ]
     cosim = phases.timed("co-simulation (initialize, step)")
     cosim.__enter__()
     try:
         guard.check()
-        system.initialize(fmu_tolerance(system, scene))
+        system.initialize()
+        refuse_if_met_at_start(system, scene)
+        master.start(scene.start, scene.stop)
         guard.check()
-        execute(system, scene, recorder, stats, progress, observers=[energy])
+        execute(master, StopRule(scene.start, scene.stop, system), observers, progress)
     except FmuTerminated as exc:  # as FMPy does: the run ends there, with what it has
         message = str(exc)
         notes.append(message)
-        reached[0] = exc.time
+        reached[0], unrecorded = record_last_success(system, recorder, exc)
+        notes.extend([unrecorded] if unrecorded else [])
     except RunError as exc:
         status, message = "failed", str(exc)
         if exc.time is not None:
@@ -230,6 +248,8 @@ def _stepped(
             quantities, accuracy, ref = _analyse(
                 scene, out, recorder, data, energy, status, options, notes
             )
+            if ref is not None:
+                keep_comparable(scene, stats, ref, accuracy, notes, reached[0])
     except Interrupted as exc:
         if status == "completed":
             status = "interrupted"
@@ -237,6 +257,7 @@ def _stepped(
     if guard.signum is not None and status == "completed":
         status = "interrupted"
         message = f"interrupted by {signal_name(guard.signum)} after the run ended"
+    meta["master_ran"] = master_ran(master)
     summary_phase = phases.timed("summary")
     summary_phase.__enter__()
     recorder.close(
@@ -360,6 +381,12 @@ def _noted(notes: list[str], what: str, header: list[str]) -> Iterator[None]:
     except Exception as exc:  # noqa: BLE001 - any failure of an analysis is reported, not raised
         text = str(exc).strip().splitlines()[0] if str(exc).strip() else ""
         notes.append(f"{what} not computed: {type(exc).__name__}: {text}".rstrip(": "))
+
+
+def master_ran(master: Master) -> dict[str, Any]:
+    """The algorithm and every setting that ran ("auto" resolved, defaults filled in; the
+    Jacobi run instead where the regime-aware master could not roll back)."""
+    return {"algorithm": master.name, **as_record(master.settings)}
 
 
 def fmu_warnings(system: CoupledSystem) -> dict[str, FmuLog]:

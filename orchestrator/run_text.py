@@ -63,6 +63,9 @@ def _stats_line(stats: dict[str, Any]) -> str:
         ("events", "events"),
     )
     parts = [f"{label} {stats[key]}" for key, label in counts if key in stats]
+    for key, label in (("rows_recorded", "rows recorded"), ("events_recorded", "events recorded")):
+        if key in stats:  # a summary rebuilt from the series (orchestrator.run_state)
+            parts.append(f"{label} {stats[key]}")
     if "wall_time" in stats:
         parts.append(f"wall time {_number(stats['wall_time']):.3f} s")
     return "  " + (", ".join(parts) if parts else "no steps taken")

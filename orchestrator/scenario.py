@@ -9,30 +9,40 @@ from __future__ import annotations
 
 import math
 import tomllib
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from components.base import Component
 from fmus.build import BuildError, build_fmu
 from fmus.ports import PortError, PortSide, join_ports
 from fmus.registry import FMU_RECORDS
 from orchestrator.errors import ScenarioError
 from orchestrator.lazy import resolve
 from orchestrator.master_settings import (
-    ALGORITHMS,
     COMMON_KEYS,
-    SETTING_KINDS,
-    STEP_KEYS,
     FixedStepSettings,
-    MasterSettings,
     SettingError,
-    master_settings,
     read_options,
+)
+from orchestrator.masters.registry import (
+    ALGORITHMS,
+    setting_kinds,
+    settings_of,
     step_key,
+    step_keys,
 )
 from orchestrator.model_info import ModelInfo, ModelInfoError, VariableInfo, model_info
-from orchestrator.scenes import ANALYSES, REFERENCES, family, shared_parameters
+from orchestrator.regular_files import TOML_LIMIT, NotARegularFile, read_regular
+from orchestrator.scene_model import (
+    Connection,
+    FmuSpec,
+    HeadlineSpec,
+    MasterSpec,
+    Scene,
+    StopCondition,
+    SweepSeries,
+    SweepSpec,
+)
+from orchestrator.scenes import ANALYSES, FAMILY_NAMES, REFERENCES, family, shared_parameters
 from orchestrator.scenes.family import Option, SharedParameter
 from orchestrator.signals import (
     Reader,
@@ -53,113 +63,11 @@ REDUCTIONS = ("final", "initial", "max", "min", "maxabs", "mean")
 #: More macro steps than this cannot finish in any sensible time: refused unless forced.
 MAX_STEPS = 1e8
 
-
-@dataclass(frozen=True)
-class FmuSpec:
-    instance: str
-    fmu_name: str  # our component's name in fmus.registry, or the FMU file's model name
-    path: Path  # the FMU file (ours: built and cached; another tool's: as the scene names it)
-    model: ModelInfo  # everything the orchestrator knows of the FMU, read from the file
-    parameters: dict[str, Any]  # SI values (int for Integer, bool for Boolean)
-    inputs: dict[str, Any]  # start values of inputs
-    component: str | None = None  # name in fmus.registry when the scene names one of ours
-    signals: dict[str, Signal] = field(default_factory=dict)  # inputs that vary in time
-
-
-@dataclass(frozen=True)
-class Connection:
-    source: tuple[str, str]  # (instance, output variable)
-    target: tuple[str, str]  # (instance, input variable)
-
-
 #: What each master's step key sets (its message when the scene gives none).
 STEP_MEANING = {
     "step": "macro step, e.g. '0.1 ms'",
     "first_step": "first step (and the step after a switch), e.g. '1 us'",
 }
-
-
-@dataclass(frozen=True)
-class MasterSpec:
-    algorithm: str
-    # The fixed macro step: master.step, else the first step the scene gives (what a
-    # fixed-step master, an exported archive's base step and crosscheck step at).
-    step: float
-    order: tuple[str, ...]
-    options: dict[str, Any] = field(default_factory=dict)  # as the scene wrote them (SI)
-    settings: MasterSettings | None = None  # the algorithm's, defaults filled in
-
-    @property
-    def own_step(self) -> tuple[str, float]:
-        """The step key this master reads (step or first_step) and the step it takes."""
-        key = step_key(self.algorithm)
-        return key, getattr(self.settings, key, self.step)
-
-
-@dataclass(frozen=True)
-class HeadlineSpec:
-    signal: tuple[str, str]
-    reduce: str
-    unit: str
-
-
-@dataclass(frozen=True)
-class StopCondition:
-    """End the run when a signal first reaches a threshold (e.g. an S&A arming angle)."""
-
-    signal: tuple[str, str]
-    threshold: float  # in the signal's SI unit
-    rising: bool  # True: stop when the signal rises to the threshold; False: falls to it
-
-
-@dataclass(frozen=True)
-class SweepSeries:
-    label: str
-    overrides: dict[str, Any]  # dotted keys, as with --set
-
-
-@dataclass(frozen=True)
-class SweepSpec:
-    """One run per (series, value): the scene with ``parameter`` set to each value."""
-
-    parameter: str  # dotted key, e.g. "fmus.verge.parameters.center_distance"
-    values: tuple[Any, ...]  # as written (a unit string or a number)
-    si_values: tuple[float, ...]  # the same in SI, for tables and plots
-    unit: str  # SI unit of the swept value ("1" when plain)
-    label: str
-    quantities: tuple[str, ...]  # headline quantities tabulated and plotted; () = all
-    series: tuple[SweepSeries, ...]
-
-
-@dataclass(frozen=True)
-class Scene:
-    path: Path
-    name: str
-    description: str
-    start: float
-    stop: float
-    fmus: dict[str, FmuSpec]
-    connections: tuple[Connection, ...]
-    master: MasterSpec
-    record: tuple[tuple[str, str], ...]
-    record_every: int
-    output_dir: Path
-    headline: dict[str, HeadlineSpec]
-    family: str | None  # [report] family: the scene family whose analysis and plot run
-    report_options: dict[str, Any]  # [report.options], read by the family and the reference
-    reference: str | None = None
-    stop_when: StopCondition | None = None
-    error_bound: float = math.inf  # the error against the reference the scene claims
-    sweep: SweepSpec | None = None  # run by ``mechcosim sweep``; ``run`` ignores it
-    study: StudySpec | None = None  # run by ``mechcosim study``; ``run`` ignores it
-
-    def component_class(self, instance: str) -> type[Component]:
-        """The physics behind one of our FMUs (for scene analyses and references only:
-        masters, recorder and system know the FMUs through their files)."""
-        component = self.fmus[instance].component
-        if component is None:
-            raise ValueError(f"FMU instance {instance!r} is not one of this project's components")
-        return FMU_RECORDS[component].component_class
 
 
 def load_scene(
@@ -197,7 +105,7 @@ def scene_from_table(
 def read_toml(path: Path) -> dict[str, Any]:
     """The parsed file, or a ScenarioError saying in one line why it cannot be read."""
     try:
-        text = path.read_bytes().decode("utf-8")
+        text = read_regular(path, TOML_LIMIT).decode("utf-8")
     except FileNotFoundError:
         raise ScenarioError(path, "", "file not found") from None
     except IsADirectoryError:
@@ -206,6 +114,8 @@ def read_toml(path: Path) -> dict[str, Any]:
         raise ScenarioError(
             path, "", f"not UTF-8 text (byte {exc.start}): expected a TOML scenario file"
         ) from None
+    except NotARegularFile as exc:
+        raise ScenarioError(path, "", str(exc.strerror)) from None
     except OSError as exc:
         raise ScenarioError(path, "", f"cannot read: {exc.strerror or exc}") from None
     try:
@@ -248,6 +158,7 @@ class _Loader:
     ) -> None:
         self.path, self.raw, self.cache_dir, self.force = path, raw, cache_dir, force
         self.span = (0.0, math.inf)  # the run's (start, stop), once [scene] is read
+        self.shared = shared_parameters(_families(raw))  # what the scene's families share
 
     def fail(self, key: str, message: str) -> ScenarioError:
         return ScenarioError(self.path, key, message)
@@ -382,7 +293,7 @@ class _Loader:
         path = (self.path.parent / text).resolve()
         if path == self.path.resolve():
             raise self.fail("scene.design", "names the scene file itself; expected a design file")
-        raw = read_toml(path)
+        raw = read_toml(self.path.parent / text)  # an error names the file as written
         if not isinstance(raw.get("design"), dict):
             raise ScenarioError(path, "design", "missing; expected a [design] table")
         out: dict[str, Any] = {}
@@ -453,12 +364,8 @@ class _Loader:
                 raise self.fail(f"{key}.fmu", str(exc)) from None
             params = self.values(entry.get("parameters", {}), f"{key}.parameters", model)
             for name, value in shared.items():
-                if _takes(component, model, shared_parameters().get(name)) or _designs(
-                    component, name
-                ):
-                    if name in params and not _takes(
-                        component, model, shared_parameters().get(name)
-                    ):
+                if _takes(component, model, self.shared.get(name)) or _designs(component, name):
+                    if name in params and not _takes(component, model, self.shared.get(name)):
                         raise self.fail(
                             f"{key}.parameters.{name}",
                             f"{name} is a quantity of the design, stated for the scene "
@@ -490,7 +397,7 @@ class _Loader:
         """A shared parameter is stated once, in [parameters], and some FMU takes it."""
         taken = {
             p.name: p
-            for p in shared_parameters().values()
+            for p in self.shared.values()
             for spec in fmus.values()
             if _takes(spec.component, spec.model, p)
         }
@@ -532,7 +439,7 @@ class _Loader:
         if len(parts) == 4 and parts[0] == "fmus" and parts[2] in ("parameters", "inputs"):
             return [(parts[1], parts[2], parts[3])]
         if len(parts) == 2 and parts[0] == "parameters":
-            shared = shared_parameters().get(parts[1])
+            shared = self.shared.get(parts[1])
             return [
                 (instance, "parameters", parts[1])
                 for instance, spec in fmus.items()
@@ -718,7 +625,8 @@ class _Loader:
             )
 
     def master(self, node: dict[str, Any], fmus: dict[str, FmuSpec], duration: float) -> MasterSpec:
-        self.check_keys(node, "master", {*COMMON_KEYS, *STEP_KEYS, *SETTING_KINDS})
+        kinds = setting_kinds()
+        self.check_keys(node, "master", {*COMMON_KEYS, *step_keys(), *kinds})
         if "algorithm" not in node:
             raise self.fail("master.algorithm", "missing")
         algorithm = self.string(node, "algorithm", "master.algorithm")
@@ -727,7 +635,7 @@ class _Loader:
                 "master.algorithm", f"unknown {algorithm!r}; expected one of {list(ALGORITHMS)}"
             )
         steps = {}
-        for k in STEP_KEYS:
+        for k in step_keys():
             if k in node:
                 steps[k] = value = self.quantity(node[k], f"master.{k}", "s")
                 if not value > 0.0:
@@ -748,9 +656,10 @@ class _Loader:
             and sorted(order) == sorted(fmus)
         ):
             raise self.fail("master.order", f"expected every instance once, from {sorted(fmus)}")
+        fixed_step = steps.get(FixedStepSettings.STEP_KEY, step)
         try:
-            options = read_options(node, self.quantity)
-            settings = master_settings(algorithm, step, duration, options)
+            options = read_options(node, self.quantity, kinds)
+            settings = settings_of(algorithm, step, duration, options, fixed_step)
         except SettingError as exc:
             raise self.fail(f"master.{exc.key}", str(exc)) from None
         largest = getattr(settings, "longest_step", None)  # a master that varies its step
@@ -768,7 +677,6 @@ class _Loader:
                     f"{duration / largest:.3g} macro steps, more than the limit "
                     f"{MAX_STEPS:.0e}: the run would not finish (--force to run it)",
                 )
-        fixed_step = steps.get(FixedStepSettings.STEP_KEY, step)
         return MasterSpec(algorithm, fixed_step, tuple(order), options, settings)
 
     def output(self, node: dict[str, Any], fmus: dict[str, FmuSpec], name: str):
@@ -975,12 +883,13 @@ class _Loader:
                 raise self.fail(key, f"no FMU of the scene shares a parameter {parts[1]!r}")
             instance, _, name = targets[0]
             return fmus[instance].model.variables[name].unit or "1"
-        if len(parts) == 2 and parts[0] == "master" and parts[1] in SETTING_KINDS:
-            if SETTING_KINDS[parts[1]].choices:
+        kinds = setting_kinds()
+        if len(parts) == 2 and parts[0] == "master" and parts[1] in kinds:
+            if kinds[parts[1]].choices:
                 raise self.fail(key, f"cannot sweep {dotted!r}: it is a word, not a number")
-            return SETTING_KINDS[parts[1]].unit
+            return kinds[parts[1]].unit
         if len(parts) == 2 and parts[0] == "master" and parts[1] in COMMON_KEYS:
-            return "s" if parts[1] == "step" else None
+            return None
         if len(parts) == 2 and parts[0] == "scene" and parts[1] in ("start", "stop"):
             return "s"
         raise self.fail(
@@ -994,6 +903,16 @@ class _Loader:
         if isinstance(value, bool) or not isinstance(value, int | float):
             raise self.fail(f"sweep.values[{k}]", f"expected a number, got {value!r}")
         return float(value)
+
+
+def _families(raw: dict[str, Any]) -> tuple[str, ...]:
+    """The families a scene names ([report] family and reference), before [report] is
+    checked: a misspelt or missing name shares nothing, and is refused with [report]."""
+    report = raw.get("report")
+    if not isinstance(report, dict):
+        return ()
+    named = (report.get("family"), report.get("reference"))
+    return tuple(dict.fromkeys(n for n in named if isinstance(n, str) and n in FAMILY_NAMES))
 
 
 def _designs(component: str | None, name: str) -> bool:

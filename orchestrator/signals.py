@@ -27,6 +27,7 @@ from pathlib import Path
 from typing import Any
 
 from orchestrator.errors import ScenarioError
+from orchestrator.regular_files import CSV_LIMIT, NotARegularFile, read_regular
 from orchestrator.units import UREG, pint_unit
 
 INTERPOLATIONS = ("linear", "hold")
@@ -271,8 +272,9 @@ def read_signal(
         row_key = [f"{key}.table[{r}]" for r in rows]
         row_text = [""] * len(rows)  # the key names the row
     elif form == "file":
-        where, times, values, lines, digest, column = _csv(reader, raw, key, var)
+        where, times, values, lines, digest, column, note = _csv(reader, raw, key, var)
         source.update(file=str(where), sha256=digest, column=column)
+        source.update({"units": note} if note else {})
         row_key = [f"{key}.file"] * len(lines)
         row_text = [f"line {n}" for n in lines]
     else:
@@ -378,9 +380,11 @@ def _csv(reader: Reader, raw: dict[str, Any], key: str, var: Any):
     path = (reader.scene_path.parent / text).resolve()
     fkey = f"{key}.file"
     try:
-        data = path.read_bytes()
+        data = read_regular(path, CSV_LIMIT)
     except FileNotFoundError:
         raise reader.fail(fkey, f"no CSV file at {path}") from None
+    except NotARegularFile as exc:
+        raise reader.fail(fkey, f"{reader.scene_path.parent / text} {exc.strerror}") from None
     except OSError as exc:
         raise reader.fail(fkey, f"cannot read {path}: {exc.strerror or exc}") from None
     try:
@@ -393,8 +397,15 @@ def _csv(reader: Reader, raw: dict[str, Any], key: str, var: Any):
         raise ScenarioError(path, fkey, f"not a UTF-8 CSV file ({exc})") from None
     if not lines or not any(cell.strip() for cell in lines[0]):
         raise ScenarioError(path, fkey, "line 1: expected a header such as 'time [s], tau [N*m]'")
-    names, units = [], []
-    for cell in lines[0]:
+    names, units, note = [], [], ""
+    if fmpy_header(lines[0]):  # FMPy's input file: the time in s, values in declared units
+        names = [cell.strip() for cell in lines[0]]
+        units = ["s" if n == "time" else var.unit or "1" for n in names]
+        note = (
+            "a header without units (FMPy's input format): time in s, values in the "
+            f"input's declared unit {var.unit or '1'}"
+        )
+    for cell in lines[0] if not note else ():
         match = _HEADER.match(cell)
         if match is None:
             raise ScenarioError(
@@ -436,7 +447,18 @@ def _csv(reader: Reader, raw: dict[str, Any], key: str, var: Any):
         numbers.append(n)
     if not times:
         raise ScenarioError(path, fkey, "no data rows after the header")
-    return path, times, values, numbers, hashlib.sha256(data).hexdigest(), column
+    return path, times, values, numbers, hashlib.sha256(data).hexdigest(), column, note
+
+
+def fmpy_header(cells: list[str]) -> bool:
+    """A header as FMPy's ``simulate_fmu`` reads an input file: ``time`` first, names
+    only, not one unit."""
+    names = [cell.strip() for cell in cells]
+    return (
+        len(names) >= 2
+        and names[0] == "time"
+        and all(n and "[" not in n and "]" not in n for n in names)
+    )
 
 
 def _affine(unit: str, target: str, path: Path, key: str, column: str) -> Callable[[float], float]:

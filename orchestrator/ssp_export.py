@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import Any
 
 from orchestrator.run import fmu_files
-from orchestrator.scenario import Scene
+from orchestrator.scene_model import Scene
 from orchestrator.signals import refuse_signals
 
 SSD = "http://ssp-standard.org/SSP1/SystemStructureDescription"

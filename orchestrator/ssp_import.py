@@ -21,7 +21,9 @@ from typing import Any
 
 from orchestrator.errors import ScenarioError
 from orchestrator.model_info import ModelInfo, ModelInfoError, base_of_unit_name, model_info
-from orchestrator.scenario import Scene, read_toml, scene_from_table
+from orchestrator.regular_files import ARCHIVE_LIMIT, NotARegularFile, read_regular
+from orchestrator.scenario import read_toml, scene_from_table
+from orchestrator.scene_model import Scene
 from orchestrator.ssp_export import OSP, SSC, SSD, SSV
 
 #: Tables a companion TOML may give (the system itself comes from the archive).
@@ -49,9 +51,11 @@ def load_ssp(
 
 def _unpack(path: Path) -> tuple[ET.Element, Path]:
     try:
-        data = path.read_bytes()
+        data = read_regular(path, ARCHIVE_LIMIT)
     except FileNotFoundError:
         raise ScenarioError(path, "", "file not found") from None
+    except NotARegularFile as exc:
+        raise ScenarioError(path, "", str(exc.strerror)) from None
     digest = hashlib.sha256(data).hexdigest()[:16]
     target = Path(tempfile.gettempdir()) / "mechcosim-ssp" / f"{path.stem}-{digest}"
     try:

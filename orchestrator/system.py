@@ -13,7 +13,8 @@ from typing import Any
 
 from orchestrator.errors import RunError
 from orchestrator.fmu_instance import FmuInstance
-from orchestrator.scenario import Scene
+from orchestrator.restore_check import RestoreCheck
+from orchestrator.scene_model import Scene
 from orchestrator.signals import scene_signals
 
 
@@ -53,7 +54,8 @@ class CoupledSystem:
         self.instances: list[FmuInstance] = []
         paths = {n: spec.path for n, spec in scene.fmus.items()} | (fmu_paths or {})
         self.paths: dict[str, Path] = paths
-        self.tolerance: float | None = None  # the integration tolerance asked of the FMUs
+        #: the integration tolerance asked of the FMUs (set by the master's setup)
+        self.tolerance: float | None = None
         try:
             for name in self.names:
                 self.instances.append(FmuInstance(name, paths[name]))
@@ -129,6 +131,13 @@ class CoupledSystem:
             self.names, lambda n, v: self.instance(n).setter(self.instance(n).refs(v))
         )
         self._drive = self.signals.apply if self.signals else None  # hot path: no call
+        #: FMUs not rolled back (their restore does not reproduce a step): no trial steps,
+        #: reads, feeds or restores them; the master steps each once per macro step
+        #: (``step_held_back``).  Empty for every scene whose FMUs restore faithfully.
+        self.held_back: set[int] = set()
+        #: doSteps of held-back FMUs the masters asked for and that were not taken
+        self.skipped_steps = 0
+        self.restore_checks: dict[int, RestoreCheck] = {}  # see watch_restores
 
     def _slot(self, i: int, var: str) -> tuple[str, int]:
         inst = self.instances[i]
@@ -168,15 +177,14 @@ class CoupledSystem:
         return slot
 
     # -- life cycle -------------------------------------------------------------------
-    def initialize(self, tolerance: float | None = None) -> None:
-        """Instantiate every FMU with its parameters and start values; ``tolerance``: the
-        integration tolerance the master asks of the FMUs (None: their own)."""
+    def initialize(self) -> None:
+        """Instantiate every FMU with its parameters and start values, and the integration
+        tolerance the master's setup asked of them (``tolerance``; None: their own)."""
         scene = self.scene
-        self.tolerance = tolerance
         for inst in self.instances:
             spec = scene.fmus[inst.name]
             values = {**spec.parameters, **spec.inputs}
-            inst.initialize(scene.start, scene.stop, values, tolerance)
+            inst.initialize(scene.start, scene.stop, values, self.tolerance)
         # Outputs with direct feedthrough depend on inputs: settle the initial exchange.
         for _ in range(len(self.instances) + 1):
             self.read_all()
@@ -190,6 +198,8 @@ class CoupledSystem:
 
     # -- transfers (hot path) ---------------------------------------------------------
     def read(self, i: int) -> None:
+        if self.held_back and i in self.held_back:
+            return  # its values stay those of the step start until its own step
         get = self._get_reals[i]
         if get is not None:
             self.values[i] = get()
@@ -238,6 +248,8 @@ class CoupledSystem:
         """Set instance i's inputs from the latest values read from its sources (its Real
         inputs from ``reals`` instead, when given, in the order of ``feeds[i]``; its Integer
         inputs from ``ints``, values read like ``self.ints``, when given)."""
+        if self.held_back and i in self.held_back:
+            return  # fed the step start's values at its own step
         feed = self.feeds[i]
         # Values equal to those the FMU holds are not set again: a set makes our FMUs
         # recompute their outputs, and a step's held inputs are often the ones the exchange
@@ -260,13 +272,26 @@ class CoupledSystem:
                 self._fed_ints[i] = (restores, values)
 
     def step(self, i: int, t: float, h: float) -> None:
+        if self.held_back and i in self.held_back:
+            self.skipped_steps += 1
+            return
         drive = self._drive
         if drive is None:
             self.instances[i].do_step(t, h)
-        else:  # the signals' values at the step start; after the step, at its end
+        else:  # the signals' values at the step start, held over it (as FMPy, libcosim)
             drive(i, t)
             self.instances[i].do_step(t, h)
-            drive(i, t + h)
+
+    def jump_signals(self, t: float) -> None:
+        """At a signal's jump at t, located as a switch: every driven input takes its value
+        after the jump (the row after the switch shows it, the exchange there carries it),
+        and what depends on it is read again."""
+        if self._drive is None:
+            return
+        for i in range(len(self.instances)):
+            self._drive(i, t)
+        for i in self.input_dependent():
+            self.read(i)
 
     def record_row(self, t: float) -> list[float]:
         row = [t]
@@ -296,7 +321,17 @@ class CoupledSystem:
 
     # -- state ------------------------------------------------------------------------
     def get_state(self) -> list[Any]:
-        return [inst.get_state() for inst in self.instances]
+        """Every FMU's state (None for one held back)."""
+        if not self.held_back and not self.restore_checks:
+            return [inst.get_state() for inst in self.instances]
+        states = []
+        for i, inst in enumerate(self.instances):
+            state = None if i in self.held_back else inst.get_state()
+            check = self.restore_checks.get(i)
+            if check is not None and state is not None:
+                check.saved(state)
+            states.append(state)
+        return states
 
     def set_state(
         self, state: list[Any], values: tuple[list[list[float]], list[list[int]]] | None = None
@@ -316,15 +351,77 @@ class CoupledSystem:
     def restore(self, state: list[Any]) -> None:
         """Restore every FMU without reading it (``values`` keep what was read before): for
         a caller that feeds them given values and steps or reads them next."""
-        for inst, s in zip(self.instances, state, strict=True):
+        if not self.held_back and not self.restore_checks:
+            for inst, s in zip(self.instances, state, strict=True):
+                inst.set_state(s)
+            return
+        for i, (inst, s) in enumerate(zip(self.instances, state, strict=True)):
+            if s is None or i in self.held_back:
+                continue
             inst.set_state(s)
+            check = self.restore_checks.get(i)
+            if check is not None:
+                check.restored(s)
+
+    def watch_restores(self, which: list[int]) -> None:
+        """Check every restore of the instances ``which`` from now on: the outputs read
+        just after it must be, bit for bit, those read when the state was saved; the first
+        that are not are kept in ``restore_failures``."""
+        for i in which:
+            self.restore_checks[i] = RestoreCheck(self.instances[i])
+
+    def restore_failures(self) -> dict[int, str]:
+        """Instance -> what differed, for the watched instances a restore failed (each
+        once: it is no longer watched)."""
+        failed = {i: c.failure for i, c in self.restore_checks.items() if c.failure}
+        for i in failed:
+            del self.restore_checks[i]
+        return failed
+
+    def hold_back(self, i: int) -> None:
+        """Roll instance i back no more: from the next macro step on it is stepped once per
+        macro step by ``step_held_back``."""
+        self.held_back.add(i)
+        self.restore_checks.pop(i, None)
+
+    def step_held_back(
+        self, t: float, h: float, values: list[list[float]], ints: list[list[int]]
+    ) -> list[int]:
+        """Step every held-back FMU over [t, t+h] with its inputs from ``values`` and
+        ``ints`` (the values read at t, as Jacobi feeds them), then read it; the instances
+        stepped."""
+        held = sorted(self.held_back)
+        for i in held:
+            feed, restores = self.feeds[i], self.instances[i].restores
+            if self._set_reals[i] is not None:
+                reals = [values[s][k] for s, k in feed.real_sources]
+                self._set_reals[i](reals)
+                self._fed_reals[i] = (restores, reals)
+            if self._set_ints[i] is not None:
+                given = [ints[s][k] for s, k in feed.int_sources]
+                self._set_ints[i](given)
+                self._fed_ints[i] = (restores, given)
+            drive = self._drive
+            if drive is not None:
+                drive(i, t)
+            self.instances[i].do_step(t, h)
+            if drive is not None:
+                drive(i, t + h)
+        self.held_back = set()  # read as any other
+        try:
+            for i in held:
+                self.read(i)
+        finally:
+            self.held_back = set(held)
+        return held
 
     def restore_faults(self, t: float, h: float) -> dict[str, str]:
         """The FMUs, not ours (ours carry our vendor annotation and restore bit for bit),
         that save and restore their state but whose restore does not reproduce a step of h
         from t: instance name -> what differs (``FmuInstance.restore_fault``).  Each is
         checked on a twin, initialized and fed as it is: a faulty restore could not leave
-        the instance itself as it was."""
+        the instance itself as it was.  A fault that acts only later is found at the restore
+        (``watch_restores``)."""
         faults = {}
         for i, (name, model) in enumerate(zip(self.names, self.models, strict=True)):
             if model.annotated or not model.can_get_set_state:
@@ -363,7 +460,12 @@ class CoupledSystem:
         return step
 
     def free_state(self, state: list[Any]) -> None:
-        for inst, s in zip(self.instances, state, strict=True):
+        for i, (inst, s) in enumerate(zip(self.instances, state, strict=True)):
+            if s is None:
+                continue
+            check = self.restore_checks.get(i)
+            if check is not None:
+                check.freed(s)
             inst.free_state(s)
 
     def instance(self, name: str) -> FmuInstance:

@@ -38,3 +38,24 @@ def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
         layer = item.path.parent.name
         if layer in LAYERS:
             item.add_marker(getattr(pytest.mark, layer))
+
+
+@pytest.fixture(scope="session")
+def scene_runs(tmp_path_factory: pytest.TempPathFactory, fmu_cache: Path):
+    """``scene_runs(name, overrides=None, plots=False)``: the run of a scene file (under
+    scenarios/, or a path) with its reference, made once per test process for the same
+    arguments, so that the tests reading one run share it."""
+    from orchestrator.run import run_scene
+    from orchestrator.scenario import load_scene
+
+    done = {}
+
+    def get(name: str | Path, overrides: dict | None = None, plots: bool = False):
+        key = (str(name), repr(sorted((overrides or {}).items())), plots)
+        if key not in done:
+            scene = load_scene(SCENARIOS / name, overrides)
+            out = tmp_path_factory.mktemp(scene.name)
+            done[key] = run_scene(scene, out, cache_dir=fmu_cache, show_progress=False, plots=plots)
+        return done[key]
+
+    return get

@@ -14,7 +14,6 @@ from orchestrator.capabilities import check_fixed_step
 from orchestrator.master_settings import FixedStepSettings
 from orchestrator.masters.macro_step import MacroStep
 from orchestrator.recorder import StepStats
-from orchestrator.scenario import Scene
 from orchestrator.system import CoupledSystem
 
 
@@ -28,25 +27,32 @@ class FixedStepMaster:
 
     def __init__(
         self,
+        settings: FixedStepSettings,
         system: CoupledSystem,
-        h: float,
-        start: float,
-        stop: float,
-        stats: StepStats,
         sequential: bool,
+        stats: StepStats | None = None,
     ) -> None:
-        check_fixed_step(system, start, stop, h)
-        self.system, self.h, self.stats, self.sequential = system, h, stats, sequential
-        self.start, self.stop = start, stop
-        self.n = _grid(start, stop, h)
+        self.settings, self.system, self.sequential = settings, system, sequential
+        self.name = "gauss-seidel" if sequential else "jacobi"
+        self.stats = StepStats() if stats is None else stats
+        self.h = settings.step
+        self.start_time, self.stop, self.n = 0.0, 0.0, 0
         self.k = 0  # steps taken
+
+    def setup(self) -> None:
+        pass  # the FMUs' own integration tolerance
+
+    def start(self, t: float, stop: float) -> None:
+        check_fixed_step(self.system, t, stop, self.h)
+        self.start_time, self.stop = t, stop
+        self.n = _grid(t, stop, self.h)
 
     def step(self, t: float, stop: float) -> MacroStep:
         system, k, n = self.system, self.k, self.n
         m = len(system.instances)
         last = k >= n - 1
         # On the grid (no accumulated rounding), the last step on stop itself.
-        grid = self.stop if last else self.start + (k + 1) * self.h
+        grid = self.stop if last else self.start_time + (k + 1) * self.h
         end, on_grid = grid, True
         if system.signals:  # an input signal's jump or kink before the grid point
             end = system.signals.land(t, grid)
@@ -68,18 +74,9 @@ class FixedStepMaster:
         return MacroStep(end, hk, record=not on_grid)
 
 
-def fixed_step_master(
-    system: CoupledSystem, scene: Scene, stats: StepStats, step: float, sequential: bool
-) -> FixedStepMaster:
-    """A fixed-step master of macro step ``step`` over the scene's span."""
-    return FixedStepMaster(system, step, scene.start, scene.stop, stats, sequential)
+def jacobi(settings: FixedStepSettings, system: CoupledSystem) -> FixedStepMaster:
+    return FixedStepMaster(settings, system, sequential=False)
 
 
-def jacobi(system: CoupledSystem, scene: Scene, stats: StepStats) -> FixedStepMaster:
-    settings: FixedStepSettings = scene.master.settings
-    return fixed_step_master(system, scene, stats, settings.step, sequential=False)
-
-
-def gauss_seidel(system: CoupledSystem, scene: Scene, stats: StepStats) -> FixedStepMaster:
-    settings: FixedStepSettings = scene.master.settings
-    return fixed_step_master(system, scene, stats, settings.step, sequential=True)
+def gauss_seidel(settings: FixedStepSettings, system: CoupledSystem) -> FixedStepMaster:
+    return FixedStepMaster(settings, system, sequential=True)

@@ -1,22 +1,23 @@
 """What a master is to the execution loop: a stepping algorithm.
 
-Given the coupled system at t, a master takes one macro step and says what it took in a
-``MacroStep``.  The loop (orchestrator/execution.py) owns everything around the steps:
-when the run ends (``scene.stop``, ``scene.stop_when``), interruption, progress, and the
-observers that record the series, the regime log and the step statistics.  A master counts
-its FMU calls (doSteps, rollbacks, rejections, coupling iterations) into the run's
-``StepStats``; the loop counts the steps and the switches.
+A factory (orchestrator/masters/registry.py) makes a master from its settings and the
+coupled system.  Its ``setup`` then tells the system what it needs of the FMUs (the
+integration tolerance they are initialized with), ``start`` is told the initialized
+system's span, and from there each call of ``step`` takes one macro step and says what it
+took in a ``MacroStep``.  The loop (orchestrator/execution.py) owns everything around the
+steps: when the run ends (the stop rule), interruption, progress, and the observers that
+record the series, the regime log and the step statistics.  A master counts its FMU calls
+(doSteps, rollbacks, rejections, coupling iterations) and what is its own into its typed
+``stats``; the step counter counts the steps and the switches there.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
-from dataclasses import dataclass
-from typing import Protocol
+from dataclasses import dataclass, field
+from typing import Any, Protocol
 
 from orchestrator.errors import RunError
 from orchestrator.recorder import StepStats
-from orchestrator.scenario import Scene
 from orchestrator.system import CoupledSystem
 
 
@@ -40,13 +41,27 @@ class MacroStep:
     #: the step ends on a known instant (an input signal's breakpoint): recorded whatever
     #: ``output.every`` says
     record: bool = False
+    # Filled in by the execution loop for the observers:
+    #: the regime changes the step made, (FMU, from, to)
+    changes: list[tuple[str, str, str]] = field(default_factory=list)
+    #: the run ends with this step
+    last: bool = False
 
 
 class Master(Protocol):
-    """A stepping algorithm: one macro step from t, never past ``stop``."""
+    """A stepping algorithm over a coupled system; see the module doc."""
 
-    def step(self, t: float, stop: float) -> MacroStep: ...
+    name: str  # the algorithm's, as a scene names it
+    system: CoupledSystem
+    stats: StepStats  # its statistics, a StepStats or a master's own subclass of it
+    settings: Any  # the settings it runs with (the summary records them)
 
+    def setup(self) -> None:
+        """Before the FMUs are initialized: set what the master needs of them on the
+        system (``system.tolerance``)."""
 
-#: How the loop makes a master for a run: (system, scene, stats) -> Master.
-MasterFactory = Callable[[CoupledSystem, Scene, StepStats], Master]
+    def start(self, t: float, stop: float) -> None:
+        """The FMUs are initialized at t; the run ends at ``stop`` at the latest."""
+
+    def step(self, t: float, stop: float) -> MacroStep:
+        """One macro step from t, never past ``stop``."""

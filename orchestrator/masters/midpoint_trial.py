@@ -36,9 +36,8 @@ from typing import Any, NamedTuple
 
 from orchestrator.master_settings import RegimeAwareSettings
 from orchestrator.masters.held_inputs import HeldInputs
-from orchestrator.masters.regime_aware import Estimate, RestartSteps, Trial
+from orchestrator.masters.regime_aware import Estimate, RegimeAwareStats, RestartSteps, Trial
 from orchestrator.masters.switches import Landing, StepStart, Switch, back_to_start, switch_time
-from orchestrator.recorder import StepStats
 from orchestrator.system import CoupledSystem
 
 
@@ -78,7 +77,7 @@ class MidpointTrials:
         self,
         system: CoupledSystem,
         settings: RegimeAwareSettings,
-        stats: StepStats,
+        stats: RegimeAwareStats,
         landing: Landing,
     ) -> None:
         self.system, self.settings, self.stats, self.landing = system, settings, stats, landing
@@ -94,7 +93,7 @@ class MidpointTrials:
         self.sloped = {j for j, _, _ in self.slopes}
         held_boxes = [b for b in self.held.black_boxes if system.index[b] not in self.sloped]
         if held_boxes and self.midpoint:
-            stats.extra.setdefault("warnings", []).append(
+            stats.warnings.append(
                 f"FMU {', '.join(map(repr, held_boxes))} declares no sampled "
                 "inputs, event indicators or regimes: its inputs are held at the step start "
                 "(first order in the step, the step sized by their change) and its internal "
@@ -248,6 +247,8 @@ class MidpointTrials:
                 rates[(j, k)] = (predicted[s][n] - values0[s][n]) / h
             self._set_ramps(rates)
         for j, indices, setter in self.slopes:
+            if j in system.held_back:  # stepped as Jacobi steps it: held (masters/held_back.py)
+                continue
             sources = [self.held.inputs[j][k].source for k in indices]
             setter([(predicted[s][n] - values0[s][n]) / h for s, n in sources])
         self._step_all(t, h, retake)

@@ -23,11 +23,13 @@ switching at one instant (chattering / Zeno) with a diagnosis.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import NamedTuple, Protocol
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any, NamedTuple, Protocol
 
 from orchestrator.errors import RunError
 from orchestrator.master_settings import RegimeAwareSettings
+from orchestrator.masters.held_back import HeldBack
 from orchestrator.masters.macro_step import MacroStep
 from orchestrator.masters.switches import (
     ChatteringGuard,
@@ -40,6 +42,55 @@ from orchestrator.masters.switches import (
 )
 from orchestrator.recorder import StepStats
 from orchestrator.system import CoupledSystem
+
+
+@dataclass
+class RegimeAwareStats(StepStats):
+    """The regime-aware master's statistics: the counters, its scheme and its own counts."""
+
+    input_hold: str | None = None  # the scheme that ran ("auto" resolved)
+    landings: int = 0  # steps that ended on a switch (single pass)
+    landing_do_steps: int = 0  # their doSteps, rejected passes included
+    landing_do_steps_max: int = 0  # ... at most in one
+    landing_pass_do_steps_max: int = 0  # the doSteps of the accepted pass, at most
+    internal_events: int = 0  # steps that ended at an FMU's own event and switched nothing
+    jumps: int = 0  # changes that shrinking the step left as large: landed on as switches
+    #: FMUs not rolled back, their restore faulty (masters/held_back.py)
+    not_rolled_back: list[str] = field(default_factory=list)
+
+    def choices(self) -> dict[str, Any]:
+        return {} if self.input_hold is None else {"input_hold": self.input_hold}
+
+    #: the counts in the order each first happened (the summary's order)
+    seen: dict[str, None] = field(default_factory=dict, repr=False)
+
+    def landed(self, do_steps: int, pass_do_steps: int) -> None:
+        """A step ended on a switch: ``do_steps`` in all, the accepted pass's among them."""
+        self.seen.setdefault("landings")
+        self.landings += 1
+        self.landing_do_steps += do_steps
+        self.landing_do_steps_max = max(self.landing_do_steps_max, do_steps)
+        self.landing_pass_do_steps_max = max(self.landing_pass_do_steps_max, pass_do_steps)
+
+    def internal_event(self) -> None:
+        self.seen.setdefault("internal_events")
+        self.internal_events += 1
+
+    def jump(self) -> None:
+        self.seen.setdefault("jumps")
+        self.jumps += 1
+
+    def counts(self) -> dict[str, Any]:
+        groups = {
+            "landings": ("landings", "landing_do_steps", "landing_do_steps_max",
+                         "landing_pass_do_steps_max"),
+            "internal_events": ("internal_events",),
+            "jumps": ("jumps",),
+        }  # fmt: skip
+        d: dict[str, Any] = {k: getattr(self, k) for g in self.seen for k in groups[g]}
+        if self.not_rolled_back:
+            d["not_rolled_back"] = list(self.not_rolled_back)
+        return d
 
 
 class Estimate(NamedTuple):
@@ -94,6 +145,12 @@ class TrialScheme(Protocol):
         """The macro step is over (free what it kept)."""
 
 
+#: Makes a trial scheme: (system, settings, statistics, landing) -> TrialScheme.
+SchemeFactory = Callable[
+    [CoupledSystem, RegimeAwareSettings, "RegimeAwareStats", Landing], TrialScheme
+]
+
+
 class RestartSteps:
     """The first step after a switch, per combination of regimes entered: a ``fraction`` of
     the step proposed there before, at least master.first_step.  With ``zero_error_only``
@@ -121,22 +178,44 @@ class RestartSteps:
 class RegimeAwareMaster:
     """Accepts, rejects and lands the trials of one scheme; see the module doc."""
 
+    name = "regime-aware"
+
     def __init__(
         self,
-        system: CoupledSystem,
         settings: RegimeAwareSettings,
-        stats: StepStats,
-        scheme: TrialScheme,
-        landing: Landing,
+        system: CoupledSystem,
+        trials: SchemeFactory,
     ) -> None:
-        self.system, self.settings, self.stats = system, settings, stats
-        self.scheme, self.landing = scheme, landing
+        """``trials`` makes the trial scheme (masters/midpoint_trial.py, single_pass.py) at
+        the start."""
+        self.system, self.settings, self.trials = system, settings, trials
+        self.stats = RegimeAwareStats()
         self.h = settings.first_step  # the step the next macro step tries first
-        self.guard = ChatteringGuard(system, landing.instant, settings.max_events_per_step)
+        self.scheme: TrialScheme | None = None  # made at the start (it reads the FMUs)
+        self.landing = Landing.of(settings)
+        self.guard = ChatteringGuard(system, self.landing.instant, settings.max_events_per_step)
+        #: foreign FMUs whose restore does not reproduce their state: not rolled back
+        self.held_back = HeldBack(system, settings, self.stats)
+        self.stats.not_rolled_back = self.held_back.names
+
+    def setup(self) -> None:
+        """The single pass asks its FMUs to integrate below its own tolerance; the midpoint
+        hold leaves them at theirs (their validated numbers stay as they are)."""
+        if self.settings.single_pass:
+            self.system.tolerance = self.settings.single_pass_control.fmu_tolerance(
+                self.settings.tolerance
+            )
+
+    def start(self, t: float, stop: float) -> None:
+        """Check the foreign FMUs' restores, then make the trial scheme."""
+        self.held_back.start(t)
+        self.stats.input_hold = self.settings.input_hold
+        self.scheme = self.trials(self.system, self.settings, self.stats, self.landing)
 
     def step(self, t: float, stop: float) -> MacroStep:
         """One accepted macro step from t: onto the first switch inside it (then the
         exchange there is settled), or as long as the error test allows."""
+        self.held_back.check(t)
         cfg, system, stats, scheme = self.settings, self.system, self.stats, self.scheme
         # Ends on an input signal's breakpoint; its hold error within the tolerance.
         h = system.signals.clip(t, min(self.h, stop - t), cfg.tolerance)
@@ -152,16 +231,20 @@ class RegimeAwareMaster:
             scheme.end()
         h = trial.h
         end = t + h
+        # The FMUs not rolled back take their one step now; their change bounds the next.
+        bound = self.held_back.step(t, h, before)
         if switch_at is None:
             ratio, first_order = trial.estimate
             scheme.accepted(start)
             self.guard.note_changes(before)
             grown = h * cfg.control.grow(ratio, first_order, scheme.growth_safety)
-            self.h = min(cfg.longest_step, max(scheme.next_step_floor, grown))
+            self.h = min(cfg.longest_step, max(scheme.next_step_floor, grown), bound)
             scheme.restart.remember(tuple(before.regimes), ratio, self.h)
             self.guard.smooth_step()
             # A regime that changed without a located switch changed at the step start.
             return MacroStep(end, h, changes_at=t, regimes_before=before.regimes)
+        if system.signals and system.signals.jump_at(end):
+            system.jump_signals(end)  # held over the step, the signal jumps at its end
         stats.iterations += settle(system, cfg.max_iterations) - 1
         changes = self.guard.note_changes(before)
         scheme.switched(trial, stats.do_steps - do_steps)
@@ -169,13 +252,13 @@ class RegimeAwareMaster:
         # output jumps) with no regime change: landed on, not counted as a switch.
         internal_only = trial.internal and not changes
         if internal_only:
-            stats.extra["internal_events"] = stats.extra.get("internal_events", 0) + 1
+            stats.internal_event()
         failure = self.guard.switch_step(h, end)
         if trial.internal:
             # The rates go on: so does the step.
-            self.h = min(cfg.longest_step, max(cfg.min_step, trial.h_asked))
+            self.h = min(cfg.longest_step, max(cfg.min_step, trial.h_asked), bound)
         else:
-            self.h = scheme.restart.step(tuple(system.regimes()))
+            self.h = min(scheme.restart.step(tuple(system.regimes())), bound)
         return MacroStep(
             end,
             h,
@@ -217,7 +300,7 @@ class RegimeAwareMaster:
                 as_large = last_ratio is not None and ratio > control.jump_ratio * last_ratio
                 stalled = stalled + 1 if as_large else 0
                 if stalled >= control.jump_shrinks:
-                    self.stats.extra["jumps"] = self.stats.extra.get("jumps", 0) + 1
+                    self.stats.jump()
                     # Land after the jump and treat it as a switch.
                     return trial, t + h
                 last_ratio = ratio

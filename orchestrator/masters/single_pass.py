@@ -52,9 +52,8 @@ from orchestrator.master_settings import RegimeAwareSettings
 from orchestrator.masters.copies import Copy, angles_with_speeds, copied_inputs
 from orchestrator.masters.held_inputs import HeldInputs
 from orchestrator.masters.input_extrapolation import InputExtrapolation
-from orchestrator.masters.regime_aware import Estimate, RestartSteps, Trial
+from orchestrator.masters.regime_aware import Estimate, RegimeAwareStats, RestartSteps, Trial
 from orchestrator.masters.switches import Landing, Readings, StepStart, Switch, switch_time
-from orchestrator.recorder import StepStats
 from orchestrator.system import CoupledSystem
 
 
@@ -74,7 +73,7 @@ class SinglePassTrials:
         self,
         system: CoupledSystem,
         settings: RegimeAwareSettings,
-        stats: StepStats,
+        stats: RegimeAwareStats,
         landing: Landing,
     ) -> None:
         self.system, self.settings, self.stats, self.landing = system, settings, stats, landing
@@ -142,7 +141,8 @@ class SinglePassTrials:
 
     def switched(self, accepted: Trial, do_steps: int) -> None:
         if not accepted.internal:
-            self._count_landing(do_steps, accepted.do_steps)
+            # Its doSteps (rejected passes included) and the accepted pass's.
+            self.stats.landed(do_steps, accepted.do_steps)
         self.extrapolation.switched(accepted.internal)
 
     def left_row(self, accepted: Trial, switch_at: float, start: StepStart) -> None:
@@ -202,7 +202,10 @@ class SinglePassTrials:
         if i in self.slopes:
             indices, setter = self.slopes[i]
             inputs, ex = self.held.inputs[i], self.extrapolation
-            setter([ex.slope(inputs[k].source) for k in indices])
+            if i in self.system.held_back:  # stepped as Jacobi steps it (masters/held_back.py)
+                setter([0.0] * len(indices))
+            else:
+                setter([ex.slope(inputs[k].source) for k in indices])
 
     def _one_pass(self, t: float, h: float, start: StepStart) -> _Pass:
         """Step every FMU once from t, those that end at their first event first (the
@@ -291,14 +294,3 @@ class SinglePassTrials:
                 worst = max(worst, miss / (tol * travel))
         unannotated = held.change_ratio(before, held.unsloped, tol) if held.unsloped else 0.0
         return Estimate(max(worst, unannotated), unannotated > worst or not ex.second_order)
-
-    def _count_landing(self, do_steps: int, pass_do_steps: int) -> None:
-        """Step statistics of the steps that ended on a switch: how many, their doSteps
-        (rejected passes included) in all and at most."""
-        extra = self.stats.extra
-        extra["landings"] = extra.get("landings", 0) + 1
-        extra["landing_do_steps"] = extra.get("landing_do_steps", 0) + do_steps
-        extra["landing_do_steps_max"] = max(extra.get("landing_do_steps_max", 0), do_steps)
-        extra["landing_pass_do_steps_max"] = max(
-            extra.get("landing_pass_do_steps_max", 0), pass_do_steps
-        )

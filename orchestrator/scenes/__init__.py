@@ -30,10 +30,12 @@ def family(name: str) -> SceneFamily:
 
 
 @cache
-def shared_parameters() -> dict[str, SharedParameter]:
-    """Every family's shared parameters, by name (the FMUs that take one joined)."""
+def shared_parameters(names: tuple[str, ...]) -> dict[str, SharedParameter]:
+    """The shared parameters of families ``names`` (a scene's [report] family and
+    reference), by name, the FMUs that take one joined: a family's shared parameters hold
+    in its own scenes only."""
     found: dict[str, SharedParameter] = {}
-    for name in FAMILY_NAMES:
+    for name in names:
         for p in family(name).shared:
             known = found.get(p.name)
             components = p.components | (known.components if known else frozenset())

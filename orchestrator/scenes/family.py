@@ -36,6 +36,9 @@ class Reference:
     wall_time: float = 0.0
     #: times the signals are known for (None: any time); outside, they are not compared
     t_range: tuple[float, float] | None = None
+    #: the headline is where the scene's stop_when condition is met (else at scene.stop):
+    #: a run that stopped on its condition is compared with it (orchestrator.stop_condition)
+    at_stop_when: bool = False
 
 
 @dataclass(frozen=True)
@@ -103,6 +106,24 @@ class SharedParameter:
 
 
 @dataclass(frozen=True)
+class Headline:
+    """The one quantity a family's runs are judged by against its monolithic model (its
+    work-precision curve, its benchmarks), and the words that name it in tables and texts."""
+
+    quantity: str  # the headline key, e.g. "turns_to_arm"
+    error_column: str  # the study table's column of its relative error, e.g. "turns_error"
+    word: str  # what it counts, in texts: "turns" ("turns error", "|turns - truth|")
+
+
+@dataclass(frozen=True)
+class Outcome:
+    """One monolithic run, as the work-precision curve and the benchmarks read it."""
+
+    value: float  # the headline quantity (NaN: the run never reached it)
+    reason: str  # why the run ended
+
+
+@dataclass(frozen=True)
 class SceneFamily:
     """One family of scenes (``[report] family`` / ``reference`` name it): what it reads,
     and where its analysis, plot and reference live ("module:function", imported when used).
@@ -114,6 +135,9 @@ class SceneFamily:
     drawing: (scene, path) -> None, writing a PNG of the scene's design to scale
     design_check: (scene) -> [message], every broken consistency rule of the scene's design
         (checked when the scene is loaded: a broken design never runs)
+    monolithic: (scene) -> ((tolerance) -> Outcome), the family's whole mechanism as one
+        model, run at a relative tolerance with the scene's physics (where it has one)
+    headline: the quantity its monolithic model and its co-simulations are compared by
     """
 
     needs: Needs = field(default_factory=Needs)
@@ -123,3 +147,5 @@ class SceneFamily:
     shared: tuple[SharedParameter, ...] = ()
     drawing: str | None = None
     design_check: str | None = None
+    monolithic: str | None = None
+    headline: Headline | None = None

@@ -39,7 +39,8 @@ from orchestrator.errors import RunError, ScenarioError
 from orchestrator.interrupt import signal_name
 from orchestrator.osp_export import export_osp
 from orchestrator.run import RunResult, fmu_files, run_scene
-from orchestrator.scenario import Scene, load_scene
+from orchestrator.scenario import load_scene
+from orchestrator.scene_model import Scene
 from orchestrator.signals import libcosim_scenario, scene_signals
 from orchestrator.ssp_export import export_ssp
 from orchestrator.ssp_import import load_ssp

@@ -19,9 +19,9 @@ from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from pathlib import Path
 from typing import Any
 
-from orchestrator.errors import ScenarioError
 from orchestrator.run import run_scene
 from orchestrator.scenario import load_scene
+from orchestrator.setting_limits import check_workers
 from orchestrator.studies.job_types import Job, JobResult
 from orchestrator.studies.job_workers import can_supervise_jobs, iter_supervised
 
@@ -104,10 +104,7 @@ def iter_jobs(
     ``stop()`` turns true no further job starts; those under way still report.  The FMUs
     must be built beforehand (load the scene once).  Local jobs run in supervised worker
     processes (``job_workers``), even with one worker."""
-    if workers is not None and workers < 1:
-        raise ScenarioError(
-            "--workers", "", f"expected a positive number of workers, got {workers}"
-        )
+    check_workers(workers)
     if not jobs:
         return
     stop = stop or (lambda: False)

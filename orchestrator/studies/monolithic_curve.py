@@ -1,11 +1,12 @@
 """The monolithic model's own work–precision curve, and the time it needs for an accuracy.
 
-For the scene families with a monolithic model of the whole mechanism (M739 and the
-clock-train S&A), the model runs with the scene's physics over its own tolerances, each
-run timed (best of a few repeats: this machine's timings of one run vary by 15-40 % with
-other load).  Every error is the relative turns-to-arm error against one truth, the same
-model at tolerance 1e-12 (turns move by a few 1e-9 relative between 1e-9 and 1e-10), so
-that master runs and monolithic runs are measured against the same value.
+For the scene families with a monolithic model of the whole mechanism (the family's
+``monolithic`` and ``headline``; M739 and the clock-train S&A), the model runs with the
+scene's physics over its own tolerances, each run timed (best of a few repeats: this
+machine's timings of one run vary by 15-40 % with other load).  Every error is the relative
+error of the family's headline quantity (the S&As' turns to arm) against one truth, the same
+model at tolerance 1e-12 (turns move by a few 1e-9 relative between 1e-9 and 1e-10), so that
+master runs and monolithic runs are measured against the same value.
 
 The time the monolithic model needs for an accuracy ``e`` is read off the curve's lower
 envelope as measured: the least wall time among the monolithic runs whose error is <= e
@@ -22,7 +23,10 @@ from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from orchestrator.scenario import Scene
+from orchestrator.lazy import resolve
+from orchestrator.scene_model import Scene
+from orchestrator.scenes import family
+from orchestrator.scenes.family import Headline, Outcome
 
 #: Tolerance of the truth run (relative local error of the monolithic integrator).
 TRUTH_TOLERANCE = 1e-12
@@ -35,26 +39,24 @@ REPEATS = 3
 #: largest ratio master time / monolithic time at the same accuracy it asks for.
 WINDOW = (1e-6, 1e-3)
 TARGET_RATIO = 2.0
-#: The headline quantity both the masters and the monolithic model are judged by.
-QUANTITY = "turns_to_arm"
 
 
 @dataclass(frozen=True)
 class MonolithicPoint:
     tolerance: float
     wall_time: float  # s, best of the repeats
-    error: float  # relative turns error against the truth (NaN: the model did not arm)
+    error: float  # relative error against the truth (NaN: the model gave no value)
 
 
 @dataclass
 class MonolithicCurve:
-    truth: float  # turns to arm at TRUTH_TOLERANCE
+    truth: float  # the headline quantity at TRUTH_TOLERANCE
     truth_wall_time: float
     points: list[MonolithicPoint]
 
-    def relative_error(self, turns: float) -> float:
-        """Relative turns error of a value against this curve's truth."""
-        return abs(turns - self.truth) / abs(self.truth)
+    def relative_error(self, value: float) -> float:
+        """Relative error of a value against this curve's truth."""
+        return abs(value - self.truth) / abs(self.truth)
 
     def time_for(self, error: float) -> float:
         """Monolithic wall time needed for ``error`` (lower envelope; NaN: never reached)."""
@@ -90,19 +92,18 @@ def _timed(fn: Callable[[], Any]) -> tuple[float, Any]:
 
 
 def monolithic_curve(
-    model: Callable[[float], Any], tolerances: Sequence[float] = CURVE_TOLERANCES
+    model: Callable[[float], Outcome], tolerances: Sequence[float] = CURVE_TOLERANCES
 ) -> MonolithicCurve | str:
-    """Run ``model(tolerance)`` (a result with ``armed``, ``turns`` and ``reason``) at the
-    truth's tolerance and at each of ``tolerances``, each timed once (``retime`` times them
-    again), errors against the truth.  When the truth does not arm (e.g. a stop before
-    arming), why, instead of a curve."""
+    """Run ``model(tolerance)`` at the truth's tolerance and at each of ``tolerances``, each
+    timed once (``retime`` times them again), errors against the truth.  When the truth
+    gives no value (e.g. a stop before arming), why, instead of a curve."""
     truth_time, truth = _timed(lambda: model(TRUTH_TOLERANCE))
-    if not truth.armed:
-        return f"did not arm at tolerance {TRUTH_TOLERANCE:g} ({truth.reason}): no turns error"
-    curve = MonolithicCurve(truth.turns, truth_time, [])
+    if not math.isfinite(truth.value):
+        return f"gave no value at tolerance {TRUTH_TOLERANCE:g} ({truth.reason}): no error"
+    curve = MonolithicCurve(truth.value, truth_time, [])
     for tol in tolerances:
         wall, result = _timed(lambda tol=tol: model(tol))
-        err = curve.relative_error(result.turns) if result.armed else math.nan
+        err = curve.relative_error(result.value) if math.isfinite(result.value) else math.nan
         curve.points.append(MonolithicPoint(tol, wall, err))
     return curve
 
@@ -119,32 +120,10 @@ def retime(curve: MonolithicCurve, model: Callable[[float], Any]) -> MonolithicC
     return MonolithicCurve(curve.truth, curve.truth_wall_time, points)
 
 
-def _m739(scene: Scene) -> Callable[[float], Any]:
-    # The same arguments as the family's reference (orchestrator/scenes/m739/report.py).
-    from orchestrator.scenes.m739.monolithic import run_m739
-    from orchestrator.scenes.m739.report import monolithic_arguments
-
-    kwargs = monolithic_arguments(scene)
-    return lambda tolerance: run_m739(tolerance=tolerance, **kwargs)
-
-
-def _clock_train(scene: Scene) -> Callable[[float], Any]:
-    # The same arguments as the family's reference (orchestrator/scenes/clock_train/report.py).
-    from orchestrator.scenes.clock_train.monolithic import run_clock_train
-    from orchestrator.scenes.clock_train.report import monolithic_arguments
-
-    kwargs = monolithic_arguments(scene)
-    return lambda tolerance: run_clock_train(tolerance=tolerance, **kwargs)
-
-
-#: Families (by the scene's ``report.reference``) with a monolithic model run over tolerances.
-MODELS: dict[str, Callable[[Scene], Callable[[float], Any]]] = {
-    "m739": _m739,
-    "clock_train": _clock_train,
-}
-
-
-def monolithic_model(scene: Scene) -> Callable[[float], Any] | None:
-    """The scene's monolithic model as a function of its tolerance; None if it has none."""
-    make = MODELS.get(scene.reference or "")
-    return make(scene) if make else None
+def monolithic_model(scene: Scene) -> tuple[Headline, Callable[[float], Outcome]] | None:
+    """The monolithic model of the scene's reference family as a function of its tolerance,
+    with the headline quantity it is judged by; None where the family has none."""
+    declared = family(scene.reference) if scene.reference else None
+    if declared is None or declared.monolithic is None or declared.headline is None:
+        return None
+    return declared.headline, resolve(declared.monolithic)(scene)

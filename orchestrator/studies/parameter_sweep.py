@@ -17,7 +17,8 @@ from pathlib import Path
 from typing import Any
 
 from orchestrator.errors import ScenarioError
-from orchestrator.scenario import Scene, SweepSeries, load_scene
+from orchestrator.scenario import load_scene
+from orchestrator.scene_model import Scene, SweepSeries
 from orchestrator.studies.jobs import Job, JobResult, run_jobs
 
 _BASE = SweepSeries("", {})

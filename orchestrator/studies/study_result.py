@@ -9,7 +9,7 @@ from typing import Any
 
 import numpy as np
 
-from orchestrator.scenario import Scene
+from orchestrator.scene_model import Scene
 from orchestrator.studies.sampling import unit_points
 from orchestrator.studies.study_table import StudySpec
 

@@ -21,6 +21,7 @@ import math
 from dataclasses import dataclass
 from typing import Any, Protocol
 
+from orchestrator.setting_limits import MIN_SAMPLES
 from orchestrator.signals import SETTABLE, signal_setting
 
 
@@ -142,6 +143,10 @@ def parse_study(loader: SceneChecks, node: Any, fmus: dict[str, Any]) -> StudySp
     samples = _positive_int(loader, node, "samples", 64)
     if samples > MAX_SAMPLES:
         raise loader.fail("study.samples", f"{samples} is more than {MAX_SAMPLES}")
+    if samples < MIN_SAMPLES:  # one sample has no spread to state
+        raise loader.fail(
+            "study.samples", f"expected at least {MIN_SAMPLES} samples, got {samples}"
+        )
     seed = node.get("seed", 0)
     if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
         raise loader.fail("study.seed", f"expected a non-negative integer, got {seed!r}")

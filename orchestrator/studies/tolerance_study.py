@@ -31,6 +31,7 @@ from orchestrator.interrupt import catching_signals
 from orchestrator.progress import ProgressBar
 from orchestrator.provenance import source_changed, source_commit
 from orchestrator.scenario import load_scene
+from orchestrator.setting_limits import check_samples, check_workers
 from orchestrator.studies.jobs import Job, JobResult, iter_jobs
 from orchestrator.studies.sampling import draw
 from orchestrator.studies.study_report import write_markdown, write_plot
@@ -84,16 +85,12 @@ def run_study(
     if spec is None:
         raise ScenarioError(scene_path, "study", "missing; the scene has no [study] table")
     n = spec.samples if samples is None else samples
-    if n < 1:
-        raise ScenarioError("--samples", "", f"expected a positive number of samples, got {n}")
+    check_samples(n)
     if n > MAX_SAMPLES:
         raise ScenarioError(
             "--samples", "", f"{n} is more than {MAX_SAMPLES} (the limit of [study] samples)"
         )
-    if workers is not None and workers < 1:
-        raise ScenarioError(
-            "--workers", "", f"expected a positive number of workers, got {workers}"
-        )
+    check_workers(workers)
     out_dir = Path(output_dir or scene.output_dir / "study").resolve()
     out_dir.mkdir(parents=True, exist_ok=True)
     csv_path = out_dir / "samples.csv"

@@ -20,7 +20,8 @@ from pathlib import Path
 import numpy as np
 
 from orchestrator.run import RunResult, reference_of, run_scene
-from orchestrator.scenario import Scene, load_scene, read_toml, scene_from_table
+from orchestrator.scenario import load_scene, read_toml, scene_from_table
+from orchestrator.scene_model import Scene
 from orchestrator.scenes.m739.report import arming_time, instance_names, turns_to_arm
 from orchestrator.studies.crosscheck import grid_steps, run_tool
 

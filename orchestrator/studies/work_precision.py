@@ -6,11 +6,12 @@ single pass, over tolerances) on a process pool or a Dask cluster, and writes
 ``work_precision.csv``, ``work_precision.png`` and ``work_precision.md`` with the observed
 convergence order of each master.
 
-Where the scene's family has a monolithic model (``monolithic_curve.MODELS``), that model
-also runs over its own tolerances; its curve is drawn with the masters on the turns-error
-panel, and each master point in the turns-error window 1e-6 .. 1e-3 gets the ratio of its
-time to the monolithic model's time at the same accuracy.  Each tolerance-driven point is
-flagged when its error (turns error, else the largest headline error) exceeds its tolerance.
+Where the scene's family has a monolithic model and a headline quantity (its ``monolithic``
+and ``headline``: the S&As' turns to arm), that model also runs over its own tolerances; its
+curve is drawn with the masters on the panel of that quantity's error, and each master
+point in the error window 1e-6 .. 1e-3 gets the ratio of its time to the monolithic model's
+time at the same accuracy.  Each tolerance-driven point is flagged when its error (that
+quantity's, else the largest headline error) exceeds its tolerance.
 """
 
 from __future__ import annotations
@@ -25,13 +26,15 @@ import numpy as np
 
 from orchestrator.accuracy import compare
 from orchestrator.errors import ScenarioError
-from orchestrator.masters import TOLERANCE_MASTERS
+from orchestrator.masters.registry import tolerance_masters
 from orchestrator.run import reference_of
-from orchestrator.scenario import Scene, load_scene
+from orchestrator.scenario import load_scene
+from orchestrator.scene_model import Scene
+from orchestrator.scenes.family import Headline
+from orchestrator.setting_limits import check_step_factors, check_tolerances, check_workers
 from orchestrator.studies.jobs import Job, JobResult, run_jobs
 from orchestrator.studies.monolithic_curve import (
     CURVE_TOLERANCES,
-    QUANTITY,
     REPEATS,
     TARGET_RATIO,
     TRUTH_TOLERANCE,
@@ -47,22 +50,29 @@ from orchestrator.studies.monolithic_curve import (
 STEP_FACTORS = (8.0, 4.0, 2.0, 1.0, 0.5, 0.25)
 TOLERANCES = (1e-1, 1e-2, 1e-3, 1e-4, 1e-5)
 COUNTERS = ("steps", "do_steps", "rollbacks", "rejections", "iterations", "events")
-COLUMNS = [
-    "master",
-    "setting",
-    "value",
-    "status",
-    "wall_time",
-    "turns_error",
-    "monolithic_time",
-    "monolithic_ratio",
-    "within_tolerance",
-    "headline_error",
-    "trajectory_error",
-    "event_time_error",
-    "energy_residual",
-    *COUNTERS,
-]
+#: The error column of a scene whose family has no monolithic model (empty there; named as
+#: in the S&A tables, so that every work-precision table has the same columns).
+NO_HEADLINE = Headline("", "turns_error", "turns")
+
+
+def columns(headline: Headline = NO_HEADLINE) -> list[str]:
+    """The table's columns; the error of the family's headline quantity is the sixth."""
+    return [
+        "master",
+        "setting",
+        "value",
+        "status",
+        "wall_time",
+        headline.error_column,
+        "monolithic_time",
+        "monolithic_ratio",
+        "within_tolerance",
+        "headline_error",
+        "trajectory_error",
+        "event_time_error",
+        "energy_residual",
+        *COUNTERS,
+    ]
 
 
 @dataclass
@@ -72,11 +82,13 @@ class Row:
     value: float
     result: JobResult
     accuracy: dict[str, float]
-    #: relative turns error against the monolithic truth (NaN: no monolithic model)
-    turns_error: float = math.nan
-    monolithic_time: float = math.nan  # the monolithic model's time for turns_error
+    #: relative error of the family's headline quantity against the monolithic truth (NaN:
+    #: no monolithic model)
+    quantity_error: float = math.nan
+    monolithic_time: float = math.nan  # the monolithic model's time for quantity_error
     #: best wall time of the repeats (the result's own when run once)
     wall_time: float = math.nan
+    headline: Headline = NO_HEADLINE  # the family's quantity quantity_error is of
 
     @property
     def monolithic_ratio(self) -> float:
@@ -84,9 +96,10 @@ class Row:
 
     @property
     def error(self) -> float:
-        """The error the tolerance is held against: turns error, else largest headline."""
-        if math.isfinite(self.turns_error):
-            return self.turns_error
+        """The error the tolerance is held against: the headline quantity's, else the
+        largest headline error."""
+        if math.isfinite(self.quantity_error):
+            return self.quantity_error
         return self.accuracy.get("headline_error", math.nan)
 
     @property
@@ -105,7 +118,7 @@ class Row:
             "value": self.value,
             "status": self.result.status,
             "wall_time": self.wall_time,
-            "turns_error": self.turns_error,
+            self.headline.error_column: self.quantity_error,
             "monolithic_time": self.monolithic_time,
             "monolithic_ratio": self.monolithic_ratio,
             "within_tolerance": self.within_tolerance,
@@ -156,7 +169,7 @@ def sweep_jobs(
             if h <= scene.stop - scene.start:
                 overrides = {"master.algorithm": master, "master.step": h}
                 jobs.append(job(overrides, f"{master}_h{h:.3e}", master))
-    for master in TOLERANCE_MASTERS:
+    for master in tolerance_masters():
         for tol in tolerances:
             # The midpoint hold: the single pass ("auto" picks it where a copy judges the
             # coupling) has a line of its own.
@@ -199,13 +212,19 @@ def work_precision(
     timed ``monolithic_repeats`` times, in this process).  The runs go in rounds, each
     round the monolithic curve once and then every master setting once, so that the two
     sides of each ratio sample the same spells of a shared machine."""
+    check_tolerances(tolerances, "--tolerances")
+    check_tolerances(start_hold_tolerances, "--start-hold-tolerances")
+    check_tolerances(monolithic_tolerances, "--monolithic-tolerances")
+    check_workers(workers)
     scene = load_scene(scene_path, overrides)
     if not scene.reference:
         raise ScenarioError(scene_path, "report.reference", "missing; the report needs a reference")
+    check_step_factors(step_factors, scene.master.step, scene.stop - scene.start)
     out_dir = Path(out_dir or Path("runs") / f"{scene.name}_work_precision")
     out_dir.mkdir(parents=True, exist_ok=True)
     reference = reference_of(scene)
-    model = monolithic_model(scene)
+    monolithic = monolithic_model(scene)
+    headline, model = monolithic if monolithic else (NO_HEADLINE, None)
     curve, notes = None, []
     if model is not None:
         curve = monolithic_curve(model, monolithic_tolerances)
@@ -231,15 +250,19 @@ def work_precision(
         # By the master, not by the keys: --set may put either key into every job.
         setting = "step" if job.label in FIXED_STEP else "tolerance"
         value = job.overrides[f"master.{setting}"]
-        row = Row(job.label, setting, value, res, accuracy, wall_time=wall)
-        if curve is not None and res.status == "completed" and QUANTITY in res.headline:
-            row.turns_error = curve.relative_error(float(res.headline[QUANTITY]["value"]))
-            row.monolithic_time = time_in_window(curve, row.turns_error)
+        row = Row(job.label, setting, value, res, accuracy, wall_time=wall, headline=headline)
+        quantity = headline.quantity
+        if curve is not None and res.status == "completed" and quantity in res.headline:
+            row.quantity_error = curve.relative_error(float(res.headline[quantity]["value"]))
+            row.monolithic_time = time_in_window(curve, row.quantity_error)
         rows.append(row)
-    records = [r.as_dict() for r in rows] + monolithic_records(curve)
-    _write_csv(records, out_dir / "work_precision.csv")
-    plot_records(records, reference.wall_time, scene.name, out_dir / "work_precision.png")
-    text = summary(rows, curve, scene, reference.wall_time, repeats, monolithic_repeats, notes)
+    records = [r.as_dict() for r in rows] + monolithic_records(curve, headline)
+    _write_csv(records, out_dir / "work_precision.csv", headline)
+    png = out_dir / "work_precision.png"
+    plot_records(records, reference.wall_time, scene.name, png, headline)
+    text = summary(
+        rows, curve, scene, reference.wall_time, repeats, monolithic_repeats, notes, headline
+    )
     (out_dir / "work_precision.md").write_text(text)
     return rows
 
@@ -248,23 +271,25 @@ def work_precision(
 MONOLITHIC = "monolithic"
 
 
-def monolithic_records(curve: MonolithicCurve | None) -> list[dict[str, Any]]:
+def monolithic_records(
+    curve: MonolithicCurve | None, headline: Headline = NO_HEADLINE
+) -> list[dict[str, Any]]:
     """The monolithic curve as table rows (the columns the masters' rows have)."""
     if curve is None:
         return []
     out = []
     for p in curve.points:
-        record: dict[str, Any] = dict.fromkeys(COLUMNS, math.nan)
+        record: dict[str, Any] = dict.fromkeys(columns(headline), math.nan)
         record.update(
             master=MONOLITHIC,
             setting="tolerance",
             value=p.tolerance,
             status="completed" if math.isfinite(p.error) else "not armed",
             wall_time=p.wall_time,
-            turns_error=p.error,
             within_tolerance="",
             **dict.fromkeys(COUNTERS, ""),
         )
+        record[headline.error_column] = p.error
         out.append(record)
     return out
 
@@ -283,9 +308,9 @@ def observed_order(rows: list[Row], master: str, error: str = "trajectory_error"
     return float(np.polyfit(x, y, 1)[0])
 
 
-def _write_csv(records: list[dict[str, Any]], path: Path) -> None:
+def _write_csv(records: list[dict[str, Any]], path: Path, headline: Headline) -> None:
     with open(path, "w", newline="") as f:
-        writer = csv.DictWriter(f, fieldnames=COLUMNS)
+        writer = csv.DictWriter(f, fieldnames=columns(headline))
         writer.writeheader()
         writer.writerows(records)
 
@@ -297,19 +322,26 @@ def _float(value: Any) -> float:
         return math.nan
 
 
-def plot_records(records: list[dict[str, Any]], reference_time: float, name: str, path: Path):
+def plot_records(
+    records: list[dict[str, Any]],
+    reference_time: float,
+    name: str,
+    path: Path,
+    headline: Headline = NO_HEADLINE,
+):
     """The diagram from table rows (``Row.as_dict`` and ``monolithic_records``, or the CSV
-    read back).  The right panel is the turns error when the rows have one (the monolithic
-    curve on the same axes), else the largest headline error."""
+    read back).  The right panel is the headline quantity's error when the rows have one
+    (the monolithic curve on the same axes), else the largest headline error."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     from matplotlib.ticker import NullFormatter
 
-    turns = any(math.isfinite(_float(r.get("turns_error"))) for r in records)
-    fig, axes = plt.subplots(1, 2, figsize=(14 if turns else 11, 4.5))
-    panels = ("trajectory_error", "turns_error" if turns else "headline_error")
+    own = headline.error_column
+    has_own = any(math.isfinite(_float(r.get(own))) for r in records)
+    fig, axes = plt.subplots(1, 2, figsize=(14 if has_own else 11, 4.5))
+    panels = ("trajectory_error", own if has_own else "headline_error")
     for ax, error in zip(axes, panels, strict=True):
         for master in dict.fromkeys(r["master"] for r in records):
             pts = [
@@ -324,18 +356,18 @@ def plot_records(records: list[dict[str, Any]], reference_time: float, name: str
                 ax.loglog(*zip(*pts, strict=True), "o-", label=master)
         if reference_time > 0:
             ax.axvline(reference_time, color="grey", ls=":", label="reference run time")
-        if error == "turns_error":
+        if error == own:
             for level in WINDOW:  # the accuracies compared with the monolithic model
                 ax.axhline(level, color="grey", lw=0.8, ls="-.")
         ax.xaxis.set_minor_formatter(NullFormatter())  # minor labels collide on short spans
         ax.set_xlabel("wall time [s]")
         label = {
-            "turns_error": "turns error (relative, vs monolithic at 1e-12)",
+            own: f"{headline.word} error (relative, vs monolithic at {TRUTH_TOLERANCE:g})",
             "headline_error": "largest headline error (relative)",
         }.get(error, error.replace("_", " ") + " (relative)")
         ax.set_ylabel(label)
         ax.grid(True, which="both", alpha=0.3)
-        if error == "turns_error":  # beside the axes: the monolithic curve spans them
+        if error == own:  # beside the axes: the monolithic curve spans them
             ax.legend(fontsize="small", loc="upper left", bbox_to_anchor=(1.02, 1.0))
         else:
             ax.legend(fontsize="small")
@@ -369,9 +401,12 @@ def summary(
     repeats: int = 1,
     monolithic_repeats: int = REPEATS,
     notes: list[str] | None = None,
+    headline: Headline = NO_HEADLINE,
 ) -> str:
     """The Markdown report: every run, the monolithic curve, and the two verdicts (time
-    against the monolithic model in the turns-error window; error against tolerance)."""
+    against the monolithic model in the error window of the family's headline quantity;
+    error against tolerance)."""
+    word = headline.word
     timing = "one run each" if repeats == 1 else f"the least of {repeats} runs"
     lines = [
         f"# Work–precision: {scene.name}",
@@ -384,20 +419,20 @@ def summary(
     if curve is not None:
         lines += [
             "",
-            "Turns error: |turns - truth| / truth for the master runs and the monolithic runs "
-            f"alike, truth = the monolithic model at tolerance {TRUTH_TOLERANCE:g} "
-            f"({curve.truth:.9g} turns, {curve.truth_wall_time:.3g} s).",
+            f"{word.capitalize()} error: |{word} - truth| / truth for the master runs and the "
+            f"monolithic runs alike, truth = the monolithic model at tolerance "
+            f"{TRUTH_TOLERANCE:g} ({curve.truth:.9g} {word}, {curve.truth_wall_time:.3g} s).",
             "",
             "x monolithic: the run's wall time / the least time of a monolithic run whose "
-            f"turns error is at most the run's (only for turns errors {WINDOW[0]:g} .. "
+            f"{word} error is at most the run's (only for {word} errors {WINDOW[0]:g} .. "
             f"{WINDOW[1]:g}; monolithic times: the least of {monolithic_repeats} runs, one in "
             "each round of the sweep, before its master runs).",
         ]
-    error_name = "turns error" if curve is not None else "largest headline error"
+    error_name = f"{word} error" if curve is not None else "largest headline error"
     head = "| master | setting | value | status | wall time [s] |"
     rule = "|---|---|---|---|---|"
     if curve is not None:
-        head += " turns error | monolithic time [s] | x monolithic |"
+        head += f" {word} error | monolithic time [s] | x monolithic |"
         rule += "---|---|---|"
     head += (
         f" {error_name} <= tolerance | headline error | trajectory error | event-time error [s] "
@@ -415,7 +450,7 @@ def summary(
             _g(d["wall_time"]),
         ]
         if curve is not None:
-            cells += [_g(r.turns_error), _g(r.monolithic_time), _g(r.monolithic_ratio)]
+            cells += [_g(r.quantity_error), _g(r.monolithic_time), _g(r.monolithic_ratio)]
         flag = {"yes": "yes", "no": "**NO**"}.get(r.within_tolerance, "")
         cells += [
             flag,
@@ -428,7 +463,7 @@ def summary(
         ]
         lines.append("| " + " | ".join(cells) + " |")
     if curve is not None:
-        lines += _monolithic_lines(rows, curve, monolithic_repeats)
+        lines += _monolithic_lines(rows, curve, monolithic_repeats, word)
     lines += ["", f"The tolerance means accuracy ({error_name} <= tolerance):", ""]
     for master in dict.fromkeys(r.master for r in rows if r.setting == "tolerance"):
         points = [r for r in rows if r.master == master and r.within_tolerance]
@@ -447,19 +482,21 @@ def summary(
     return "\n".join(lines) + "\n"
 
 
-def _monolithic_lines(rows: list[Row], curve: MonolithicCurve, repeats: int) -> list[str]:
+def _monolithic_lines(
+    rows: list[Row], curve: MonolithicCurve, repeats: int, word: str
+) -> list[str]:
     lines = [
         "",
         f"Monolithic model over its tolerances (wall time: the least of {repeats} runs):",
         "",
-        "| tolerance | wall time [s] | turns error |",
+        f"| tolerance | wall time [s] | {word} error |",
         "|---|---|---|",
     ]
     lines += [f"| {p.tolerance:g} | {p.wall_time:.3g} | {_g(p.error)} |" for p in curve.points]
     lo, hi = WINDOW
     lines += [
         "",
-        f"Against the monolithic curve (turns error {lo:g} .. {hi:g}, target <= "
+        f"Against the monolithic curve ({word} error {lo:g} .. {hi:g}, target <= "
         f"{TARGET_RATIO:g}x the monolithic time at the same accuracy):",
         "",
     ]
@@ -467,7 +504,7 @@ def _monolithic_lines(rows: list[Row], curve: MonolithicCurve, repeats: int) -> 
         ratios = [
             (r.value, r.monolithic_ratio)
             for r in rows
-            if r.master == master and lo <= r.turns_error <= hi
+            if r.master == master and lo <= r.quantity_error <= hi
         ]
         if not ratios:
             lines.append(f"- {master}: no point in the window")

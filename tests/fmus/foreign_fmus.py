@@ -57,6 +57,7 @@ import tempfile
 import uuid
 import zipfile
 from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 from xml.dom.minidom import parseString
 from xml.etree import ElementTree as ET
@@ -169,6 +170,7 @@ FAULTS = (
     "long_error",  # doStep logs 2000 lines, then 100000 characters, and returns fmi2Error
     "by_n_sub",  # n_sub 101, 102, 103: segfault, hang, stop; others: no fault
     "terminate_segfault",  # fmi2Terminate segfaults
+    "terminate_after",  # doStep completes its step, then returns fmi2Discard, terminated
 )
 
 
@@ -559,17 +561,22 @@ PI_CONTROLLER_VARIABLES = (
 )
 
 
-def build_pi_controller(dest: Path, forgets_integrator: bool = False) -> Path:
+def build_pi_controller(
+    dest: Path, forgets_integrator: bool = False, after_jump: bool = False
+) -> Path:
     """Compile PiController (its initialization fails unless the set point u_s is 0) and
     pack it as ``dest/PiController.fmu``; return its path.  ``forgets_integrator``: its
     fmi2SetFMUstate restores everything but the integral x (``PiController-forgets.fmu``),
-    a state restore that does not reproduce a step."""
-    suffix = "-forgets" if forgets_integrator else ""
+    a state restore that does not reproduce a step; with ``after_jump`` only once the set
+    point has left its value at the first step (``PiController-forgets-after-jump.fmu``)."""
+    suffix = ("-forgets" if forgets_integrator else "") + ("-after-jump" if after_jump else "")
+    defines = ["-DPI_CONTROLLER_FORGETS_INTEGRATOR"] if forgets_integrator else []
+    defines += ["-DPI_CONTROLLER_FORGETS_AFTER_JUMP"] if after_jump else []
     return _build_c_fmu(
         PI_CONTROLLER_SOURCE,
         "PiController",
         "PI_CONTROLLER_GUID",
-        ["-DPI_CONTROLLER_FORGETS_INTEGRATOR"] if forgets_integrator else [],
+        defines,
         _pi_controller_model_description,
         Path(dest) / f"PiController{suffix}.fmu",
     )
@@ -616,3 +623,47 @@ def _pi_controller_model_description(guid: str) -> bytes:
     ET.SubElement(initial, "Unknown", index="5", dependencies="1 2 3 4")
     ET.SubElement(initial, "Unknown", index="6", dependencies="")
     return parseString(ET.tostring(root, "UTF-8")).toprettyxml(indent="  ", encoding="UTF-8")
+
+
+#: A scene of our Inertia driving the foreign TorsionBody (``{fmu}``: its file) through its
+#: flange; its initial angle ``{phi0}`` in rad, for a parameter the FMU declares in degrees.
+TORSION_BODY_SCENE = """
+[scene]
+name = "deg_parameter"
+stop = "20 ms"
+
+[fmus.a]
+component = "Inertia"
+parameters = {{ J = "2e-4 kg*m^2", w0 = "10 rad/s" }}
+
+[fmus.c]
+fmu = "{fmu}"
+parameters = {{ "body.J" = "1e-4 kg*m^2", "spring.k" = "2 N*m/rad", "body.phi0" = "{phi0} rad" }}
+
+[[connections]]
+from = "c.flange.tau"
+to = "a.tau"
+
+[[connections]]
+from = "a.phi"
+to = "c.flange.phi"
+
+[[connections]]
+from = "a.w"
+to = "c.flange.w"
+
+[master]
+algorithm = "jacobi"
+step = "1 ms"
+
+[output]
+record = ["a.phi", "a.w", "c.body.phi", "c.body.w", "c.flange.tau"]
+"""
+
+
+@dataclass(frozen=True)
+class ForeignFmus:
+    directory: Path  # all three, under their file names
+    torsion_body: Path  # TorsionBody.fmu, with fmi2Get/SetFMUstate
+    stateless: Path  # TorsionBody-nostate.fmu, without
+    container: Path  # TorsionBody-container.fmu: FMPy's container around the first, 1 ms step

@@ -12,7 +12,7 @@ from pathlib import Path
 import foreign_fmus
 import numpy as np
 import pytest
-from test_ssp_units import SCENE
+from foreign_fmus import TORSION_BODY_SCENE
 
 from orchestrator.cli import main
 
@@ -27,7 +27,9 @@ CRASHES = {"segfault": ("signal", 11), "abort": ("signal", 6), "exit": ("exit_co
 def scene_with(directory: Path, fault: str | None, name: str) -> Path:
     fmu = foreign_fmus.build_torsion_body(directory, fault=fault, fault_time=FAULT_TIME)
     path = directory / f"{name}.toml"
-    text = SCENE.format(fmu=fmu, phi0=0.1).replace('name = "deg_parameter"', f'name = "{name}"')
+    text = TORSION_BODY_SCENE.format(fmu=fmu, phi0=0.1).replace(
+        'name = "deg_parameter"', f'name = "{name}"'
+    )
     path.write_text(text)
     return path
 

@@ -70,17 +70,6 @@ record = ["a.phi", "a.w", "c.body.phi", "c.body.w", "c.flange.tau"]
 """
 
 
-@pytest.fixture(scope="module")
-def foreign(tmp_path_factory) -> Path:
-    if foreign_fmus.c_compiler() is None:
-        pytest.skip("no C compiler")
-    d = tmp_path_factory.mktemp("foreign")
-    body = foreign_fmus.build_torsion_body(d)
-    foreign_fmus.build_torsion_body(d, can_get_set_state=False)
-    foreign_fmus.build_container(d, body, fixed_step=1e-3)
-    return d
-
-
 def write_scene(directory: Path, text: str) -> Path:
     path = directory / "scene.toml"
     path.write_text(text)
@@ -105,7 +94,7 @@ def assert_matches_reference(result, step: float = 1e-3) -> None:
 # -- foreign FMUs in scenes ---------------------------------------------------------------
 @needs_cc
 def test_c_fmu_in_a_scene_matches_the_hand_written_reference(tmp_path, foreign) -> None:
-    scene = load_scene(write_scene(tmp_path, foreign_scene(str(foreign / "TorsionBody.fmu"))))
+    scene = load_scene(write_scene(tmp_path, foreign_scene(str(foreign.torsion_body))))
     assert scene.fmus["c"].component is None and not scene.fmus["c"].model.annotated
     assert_matches_reference(
         run_scene(scene, output_dir=tmp_path / "run", show_progress=False, plots=False)
@@ -114,7 +103,7 @@ def test_c_fmu_in_a_scene_matches_the_hand_written_reference(tmp_path, foreign) 
 
 @needs_cc
 def test_container_fmu_in_a_scene_matches_the_same_reference(tmp_path, foreign) -> None:
-    fmu = foreign / "TorsionBody-container.fmu"
+    fmu = foreign.directory / "TorsionBody-container.fmu"
     scene = load_scene(write_scene(tmp_path, foreign_scene(str(fmu))))
     assert "FMPy" in scene.fmus["c"].model.generation_tool or scene.fmus["c"].model.variables
     assert_matches_reference(
@@ -124,7 +113,7 @@ def test_container_fmu_in_a_scene_matches_the_same_reference(tmp_path, foreign) 
 
 @needs_cc
 def test_dotted_names_work_in_overrides(tmp_path, foreign) -> None:
-    path = write_scene(tmp_path, foreign_scene(str(foreign / "TorsionBody.fmu")))
+    path = write_scene(tmp_path, foreign_scene(str(foreign.torsion_body)))
     scene = load_scene(path, {"fmus.c.parameters.spring.k": "3 N*m/rad"})
     assert scene.fmus["c"].parameters["spring.k"] == 3.0
     with pytest.raises(ScenarioError, match=r"fmus\.c\.parameters.*spring\.q"):
@@ -133,13 +122,13 @@ def test_dotted_names_work_in_overrides(tmp_path, foreign) -> None:
 
 @needs_cc
 def test_regime_aware_master_steps_a_black_box_with_rollback(tmp_path, foreign) -> None:
-    path = write_scene(tmp_path, foreign_scene(str(foreign / "TorsionBody.fmu"), "regime-aware"))
+    path = write_scene(tmp_path, foreign_scene(str(foreign.torsion_body), "regime-aware"))
     scene = load_scene(path, {"master.tolerance": 1e-2, "master.first_step": "0.1 ms"})
     r = run_scene(scene, output_dir=tmp_path / "run", show_progress=False, plots=False)
     assert r.status == "completed", r.message
     assert r.stats.rollbacks > 0
     # It cannot know which inputs are sampled states: it says so and holds them.
-    (warning,) = r.stats.extra["warnings"]
+    (warning,) = r.stats.warnings
     assert "'c' declares no sampled inputs" in warning
     # Against the closed form of the two bodies (averaging the black box's inputs would
     # have missed it by 0.3 at this tolerance; held, the error is 2.5e-5).
@@ -150,9 +139,9 @@ def test_regime_aware_master_steps_a_black_box_with_rollback(tmp_path, foreign) 
 @needs_cc
 @pytest.mark.parametrize("fmu", ["TorsionBody-nostate.fmu", "TorsionBody-container.fmu"])
 def test_regime_aware_master_says_what_it_gives_up_without_state(tmp_path, foreign, fmu) -> None:
-    path = write_scene(tmp_path, foreign_scene(str(foreign / fmu), "regime-aware"))
+    path = write_scene(tmp_path, foreign_scene(str(foreign.directory / fmu), "regime-aware"))
     r = run_scene(load_scene(path), output_dir=tmp_path / "run", show_progress=False, plots=False)
-    (warning,) = r.stats.extra["warnings"]
+    (warning,) = r.stats.warnings
     assert "'c' cannot save and restore its state" in warning and "fixed-step Jacobi" in warning
     assert_matches_reference(r)
 
@@ -192,7 +181,7 @@ def test_an_fmu_without_variable_steps_is_refused_where_a_master_varies_its_step
     # The regime-aware master sizes every step: it falls back to fixed-step Jacobi, on a grid.
     path = write_scene(tmp_path, foreign_scene(str(fmu), "regime-aware"))
     r = run_scene(load_scene(path), output_dir=tmp_path / "aware", show_progress=False)
-    (warning,) = r.stats.extra["warnings"]
+    (warning,) = r.stats.warnings
     assert warning.startswith(
         "FMU 'c' cannot take communication steps of varying size "
         "(canHandleVariableCommunicationStepSize is false), which the regime-aware master needs"
@@ -212,7 +201,7 @@ def test_an_fmu_without_variable_steps_is_refused_where_a_master_varies_its_step
 
 @needs_cc
 def test_foreign_connection_units_are_checked(tmp_path, foreign) -> None:
-    text = foreign_scene(str(foreign / "TorsionBody.fmu")).replace(
+    text = foreign_scene(str(foreign.torsion_body)).replace(
         'from = "a.phi"\nto = "c.flange.phi"', 'from = "a.w"\nto = "c.flange.phi"'
     )
     text = text.replace('from = "a.w"\nto = "c.flange.w"', 'from = "a.phi"\nto = "c.flange.w"')

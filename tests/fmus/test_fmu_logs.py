@@ -9,7 +9,7 @@ from pathlib import Path
 
 import foreign_fmus
 import pytest
-from test_ssp_units import SCENE
+from foreign_fmus import TORSION_BODY_SCENE
 
 from orchestrator import fmu_log
 from orchestrator.cli import main
@@ -24,7 +24,7 @@ def run(tmp_path: Path, fault: str, capsys: pytest.CaptureFixture) -> tuple[int,
         pytest.skip("no C compiler to build the foreign test FMUs")
     fmu = foreign_fmus.build_torsion_body(tmp_path, fault=fault, fault_time=FAULT_TIME)
     scene = tmp_path / "s.toml"
-    scene.write_text(SCENE.format(fmu=fmu, phi0=0.1).replace("deg_parameter", "s"))
+    scene.write_text(TORSION_BODY_SCENE.format(fmu=fmu, phi0=0.1).replace("deg_parameter", "s"))
     out = tmp_path / "out"
     code = main(["run", str(scene), "--no-progress", "--output", str(out)])
     return code, capsys.readouterr().out, json.loads((out / "summary.json").read_text())

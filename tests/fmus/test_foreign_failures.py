@@ -16,10 +16,10 @@ from pathlib import Path
 import foreign_fmus
 import numpy as np
 import pytest
-from test_ssp_units import SCENE
+from foreign_fmus import TORSION_BODY_SCENE
+from scene_run import run_file
 
 from orchestrator.errors import RunError, ScenarioError
-from orchestrator.run import run_scene
 from orchestrator.scenario import load_scene
 
 if foreign_fmus.c_compiler() is None:
@@ -43,7 +43,9 @@ def build(tmp_path_factory: pytest.TempPathFactory):  # noqa: ANN201 - a factory
 
 
 def write_scene(d: Path, fmu: Path, name: str, record: str | None = None) -> Path:
-    text = SCENE.format(fmu=fmu, phi0=0.1).replace('name = "deg_parameter"', f'name = "{name}"')
+    text = TORSION_BODY_SCENE.format(fmu=fmu, phi0=0.1).replace(
+        'name = "deg_parameter"', f'name = "{name}"'
+    )
     if record:
         text = text.replace('"c.flange.tau"]', f'"c.flange.tau", "{record}"]')
     path = d / f"{name}.toml"
@@ -63,7 +65,7 @@ def with_description(fmu: Path, target: Path, edit) -> Path:  # noqa: ANN001 - s
 
 
 def run(path: Path, out: Path, overrides: dict | None = None):  # noqa: ANN201 - RunResult
-    return run_scene(load_scene(path, overrides), output_dir=out, show_progress=False, plots=False)
+    return run_file(path, out, overrides)
 
 
 def summary(out: Path) -> dict:

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import math
 import uuid
-from dataclasses import dataclass
 from pathlib import Path
 
 import foreign_fmus
@@ -14,12 +13,7 @@ from fmpy import extract, read_model_description, simulate_fmu
 from fmpy.fmi1 import FMICallException
 from fmpy.fmi2 import FMU2Slave
 from fmpy.validation import validate_fmu
-from foreign_fmus import (
-    ForeignFmuError,
-    build_container,
-    build_torsion_body,
-    torsion_body_reference,
-)
+from foreign_fmus import ForeignFmus, torsion_body_reference
 
 from fmus.build import build_fmu
 
@@ -30,24 +24,6 @@ STEP = 1e-3
 # Inertia A driving TorsionBody; stiff enough that the coupling matters within 100 steps.
 PARAMS = dict(J_a=2e-4, phi0_a=0.1, w0_a=10.0, J=1e-4, k=2.0, d=2e-3, phi0=0.05, w0=-3.0)
 N_SUB = 10
-
-
-@dataclass(frozen=True)
-class ForeignFmus:
-    torsion_body: Path
-    stateless: Path
-    container: Path
-
-
-@pytest.fixture(scope="module")
-def foreign(tmp_path_factory: pytest.TempPathFactory) -> ForeignFmus:
-    dest = tmp_path_factory.mktemp("foreign_fmus")
-    try:
-        body = build_torsion_body(dest)
-        stateless = build_torsion_body(dest, can_get_set_state=False)
-    except ForeignFmuError as exc:
-        pytest.skip(str(exc))
-    return ForeignFmus(body, stateless, build_container(dest, body, fixed_step=STEP))
 
 
 class Slave:

@@ -37,11 +37,11 @@ def bodies(tmp_path_factory) -> dict[str, Path]:
 
 def error(fmu: Path, hold: str, step: str, directory: Path) -> tuple[float, object]:
     """Largest error of body a's angle against the closed form, the regime-aware master
-    with ``hold`` taking every step of ``step`` (a tolerance no step misses)."""
+    with ``hold`` taking steps of ``step`` (the largest tolerance: no step is rejected)."""
     directory.mkdir(parents=True)
     path = write_scene(directory, foreign_scene(str(fmu), "regime-aware"))
     overrides = {
-        "master.tolerance": 1e3,
+        "master.tolerance": 1.0,
         "master.first_step": step,
         "master.max_step": step,
         "master.input_hold": hold,
@@ -70,14 +70,17 @@ def test_input_derivatives_make_the_black_box_second_order(tmp_path, bodies, hol
         for step in ("1 ms", "0.5 ms"):
             where = tmp_path / f"{kind}-{step[:-3]}"
             errors[kind, step], r = error(fmu, hold, step, where)
-            assert r.stats.rejections == 0 and len(r.signal("time")) in (201, 401)
+            # Every step is the one asked but the second (shortened at the start's jolt).
+            steps = np.diff(r.signal("time"))
+            h = float(step.split()[0]) * 1e-3
+            assert r.stats.rejections == 0 and np.sum(np.abs(steps - h) > 1e-12) <= 2
         if hold == "midpoint":
             # Held at its step start, the black box is said to be first order; ramped, not.
-            warnings = r.stats.extra.get("warnings", [])
+            warnings = r.stats.warnings
             said = any("'c' declares no sampled inputs" in w for w in warnings)
             assert said == (kind == "held")
-    # Measured, midpoint: held 4.0e-3 and 1.6e-3 rad, ramped 1.2e-3 and 2.9e-4 rad;
-    # single pass: held 3.9e-3 and 1.5e-3 rad, ramped 1.0e-3 and 2.6e-4 rad.
+    # Measured, midpoint: held 4.0e-3 and 1.5e-3 rad, ramped 1.2e-3 and 2.9e-4 rad;
+    # single pass: held 4.0e-3 and 1.5e-3 rad, ramped 1.0e-3 and 2.6e-4 rad.
     for step in ("1 ms", "0.5 ms"):
         assert errors["ramped", step] < errors["held", step] / 3.0
     # Halving the step: the held inputs' error falls by less than 3 (first order in the

@@ -10,6 +10,7 @@ import foreign_fmus
 import numpy as np
 import pytest
 from fmpy import simulate_fmu
+from scene_run import run_file
 
 from orchestrator.errors import ScenarioError
 from orchestrator.run import run_scene
@@ -49,12 +50,7 @@ step = "1 ms"
 
 
 def run(path: Path, tmp_path: Path, algorithm: str):
-    result = run_scene(
-        load_scene(path, {"master.algorithm": algorithm}),
-        output_dir=tmp_path / algorithm,
-        show_progress=False,
-    )
-    return result
+    return run_file(path, tmp_path / algorithm, {"master.algorithm": algorithm})
 
 
 @pytest.mark.parametrize("algorithm", MASTERS)
@@ -118,6 +114,37 @@ def test_agrees_with_fmpy_simulate_fmu_given_the_same_input(
     assert ours.signal("c.x")[-1] == pytest.approx(
         (1 - U_M) * 4.5e-3 + (-0.5 - U_M) * 4e-3 - U_M * 1.5e-3, rel=1e-12
     )
+
+
+@pytest.mark.parametrize("algorithm", ("jacobi", "gauss-seidel"))
+def test_a_ramp_is_recorded_as_fmpy_records_it(
+    controller: Path, tmp_path: Path, algorithm: str
+) -> None:
+    """A set-point ramp into the controller, whose output follows the set point directly
+    (y = kp (u_s - u_m) + ki x): every row, y and x, equals FMPy's given the same ramp (the
+    input held over each step, the row after it showing what the step used; before, y read
+    the ramp one step ahead)."""
+    ramp = '{ ramp = ["1 ms", "8 ms"], from = 0, to = 1 }'
+    path = scene(tmp_path, controller, ramp)
+    ours = run(path, tmp_path, algorithm)
+    assert ours.status == "completed", ours.message
+    given = np.array([(0.0, 0.0), (1e-3, 0.0), (8e-3, 1.0), (1e-2, 1.0)],
+                     dtype=[("time", float), ("u_s", float)])  # fmt: skip
+    theirs = simulate_fmu(
+        str(controller),
+        stop_time=0.01,
+        output_interval=1e-3,
+        input=given,
+        start_values={"kp": KP, "ki": KI, "u_m": U_M},
+        output=["x", "y", "u_s"],
+    )
+    assert len(theirs) == len(ours.data) == 11
+    for name in ("x", "y", "u_s"):
+        np.testing.assert_allclose(
+            ours.signal(f"c.{name}"), theirs[name], rtol=1e-12, atol=1e-15, err_msg=name
+        )
+    # the row at 2 ms holds the set point the step from 1 ms used: 0
+    assert ours.signal("c.u_s")[2] == 0.0 and ours.signal("c.u_s")[3] == pytest.approx(1 / 7)
 
 
 @pytest.mark.parametrize("algorithm", MASTERS)

@@ -10,6 +10,7 @@ from pathlib import Path
 
 import foreign_fmus
 import pytest
+from foreign_fmus import TORSION_BODY_SCENE
 
 from orchestrator.errors import ScenarioError
 from orchestrator.run import run_scene
@@ -20,39 +21,6 @@ from orchestrator.studies.crosscheck import REQUIRED, crosscheck
 
 PHI0 = 0.1  # rad, given to the scene as a quantity
 
-SCENE = """
-[scene]
-name = "deg_parameter"
-stop = "20 ms"
-
-[fmus.a]
-component = "Inertia"
-parameters = {{ J = "2e-4 kg*m^2", w0 = "10 rad/s" }}
-
-[fmus.c]
-fmu = "{fmu}"
-parameters = {{ "body.J" = "1e-4 kg*m^2", "spring.k" = "2 N*m/rad", "body.phi0" = "{phi0} rad" }}
-
-[[connections]]
-from = "c.flange.tau"
-to = "a.tau"
-
-[[connections]]
-from = "a.phi"
-to = "c.flange.phi"
-
-[[connections]]
-from = "a.w"
-to = "c.flange.w"
-
-[master]
-algorithm = "jacobi"
-step = "1 ms"
-
-[output]
-record = ["a.phi", "a.w", "c.body.phi", "c.body.w", "c.flange.tau"]
-"""
-
 
 @pytest.fixture(scope="module")
 def scene_file(tmp_path_factory) -> Path:
@@ -61,7 +29,7 @@ def scene_file(tmp_path_factory) -> Path:
     d = tmp_path_factory.mktemp("deg")
     fmu = foreign_fmus.build_torsion_body(d, phi0_in_degrees=True)
     path = d / "deg_parameter.toml"
-    path.write_text(SCENE.format(fmu=fmu, phi0=PHI0))
+    path.write_text(TORSION_BODY_SCENE.format(fmu=fmu, phi0=PHI0))
     return path
 
 

@@ -18,7 +18,7 @@ from pathlib import Path
 import foreign_fmus
 import numpy as np
 import pytest
-from test_ssp_units import SCENE
+from foreign_fmus import TORSION_BODY_SCENE
 
 from orchestrator.cli import main
 
@@ -46,7 +46,9 @@ SWEEP = [HEALTHY, SEGFAULT, HEALTHY, HANG, HEALTHY, STOP, HEALTHY]
 
 
 def scene_text(fmu: Path, name: str, call_timeout: str = f"{CALL_TIMEOUT} s") -> str:
-    text = SCENE.format(fmu=fmu, phi0=0.1).replace('name = "deg_parameter"', f'name = "{name}"')
+    text = TORSION_BODY_SCENE.format(fmu=fmu, phi0=0.1).replace(
+        'name = "deg_parameter"', f'name = "{name}"'
+    )
     text = text.replace('step = "1 ms"', f'step = "1 ms"\ncall_timeout = "{call_timeout}"')
     return text + '\n[report.headline]\nfinal_phi = { signal = "c.body.phi", reduce = "final" }\n'
 

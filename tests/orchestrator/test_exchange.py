@@ -61,28 +61,27 @@ def test_values_an_fmu_holds_are_not_set_again_until_a_state_is_restored() -> No
 
 
 def test_the_single_pass_asks_its_fmus_for_a_tolerance_below_its_own() -> None:
-    from orchestrator.masters.regime_aware_choice import fmu_tolerance
+    """The master's setup sets the tolerance the FMUs are initialized with ("auto" resolved
+    by the factory, once)."""
+    from orchestrator.masters.registry import algorithm
+
+    def asked_of(scene) -> float | None:
+        system = CoupledSystem(scene)
+        try:
+            algorithm(scene.master.algorithm).make(scene.master.settings, system).setup()
+            return system.tolerance
+        finally:
+            system.close()
 
     asked = {}
     for hold in ("auto", "extrapolated", "midpoint"):
         for tol in (1e-1, 1e-5):
-            scene = load_scene(
-                SCENARIOS / "m739.toml", {"master.input_hold": hold, "master.tolerance": tol}
-            )
-            system = CoupledSystem(scene)
-            try:
-                asked[hold, tol] = fmu_tolerance(system, scene)
-            finally:
-                system.close()
+            overrides = {"master.input_hold": hold, "master.tolerance": tol}
+            asked[hold, tol] = asked_of(load_scene(SCENARIOS / "m739.toml", overrides))
     assert asked["auto", 1e-1] == asked["extrapolated", 1e-1] == 1e-5  # at most 1e-5
     assert asked["auto", 1e-5] == pytest.approx(1e-6)  # a tenth of its own below that
     assert asked["midpoint", 1e-1] is None and asked["midpoint", 1e-5] is None
-    jacobi = load_scene(SCENARIOS / "m739.toml", {"master.algorithm": "jacobi"})
-    system = CoupledSystem(jacobi)
-    try:
-        assert fmu_tolerance(system, jacobi) is None
-    finally:
-        system.close()
+    assert asked_of(load_scene(SCENARIOS / "m739.toml", {"master.algorithm": "jacobi"})) is None
 
 
 def test_a_hosts_tolerance_is_the_fmus_unless_the_parameter_is_set() -> None:

@@ -9,9 +9,11 @@ from pathlib import Path
 
 import pytest
 
-from orchestrator import execution, scenario
-from orchestrator.master_settings import ALGORITHMS, SETTINGS, TOLERANCE_MASTERS, FixedStepSettings
-from orchestrator.masters import MacroStep
+from orchestrator.lazy import resolve
+from orchestrator.master_settings import FixedStepSettings
+from orchestrator.masters.macro_step import MacroStep
+from orchestrator.masters.registry import ALGORITHMS, Algorithm, tolerance_masters
+from orchestrator.recorder import StepStats
 from orchestrator.run import fmu_files, run_scene
 from orchestrator.scenario import load_scene
 from orchestrator.system import CoupledSystem
@@ -94,7 +96,7 @@ def test_fixed_step_masters_record_what_one_hand_written_loop_records(
     assert result.data.tolist() == rows  # bit for bit
     assert [(t, s, a, b) for t, s, a, b in result.events] == events
     if "scene.stop_when" in overrides:
-        assert result.stats.extra["stopped_by_condition"]
+        assert result.stats.stopped_by_condition
 
 
 class _Spy:
@@ -103,8 +105,8 @@ class _Spy:
     def __init__(self, factory) -> None:
         self.factory, self.steps = factory, []
 
-    def __call__(self, system, scene, stats):
-        master = self.factory(system, scene, stats)
+    def __call__(self, settings, system):
+        master = self.factory(settings, system)
         step = master.step
 
         def spied(t, stop):
@@ -120,7 +122,7 @@ def _scene_for(algorithm: str, every: int, hold: str | None = None):
     overrides = {"master.algorithm": algorithm, "output.every": every}
     if hold is not None:
         overrides["master.input_hold"] = hold
-    if algorithm not in TOLERANCE_MASTERS:
+    if algorithm not in tolerance_masters():
         return load_scene(SCENARIOS / "two_inertias.toml", overrides | {"scene.stop": "0.1 s"})
     # The M739's first 4 ms: a dozen escapement switches, each recorded on both sides.
     overrides |= {"scene.stop": "4 ms", "master.tolerance": 1e-2}
@@ -129,8 +131,8 @@ def _scene_for(algorithm: str, every: int, hold: str | None = None):
 
 #: Every master, the regime-aware one with each of its schemes.
 MASTERS_AND_SCHEMES = [
-    *((a, None) for a in ALGORITHMS if a not in TOLERANCE_MASTERS),
-    *((a, hold) for a in TOLERANCE_MASTERS for hold in ("midpoint", "extrapolated")),
+    *((a, None) for a in ALGORITHMS if a not in tolerance_masters()),
+    *((a, hold) for a in tolerance_masters() for hold in ("midpoint", "extrapolated")),
 ]
 
 
@@ -142,15 +144,16 @@ def test_output_every_thins_the_record_of_every_master(
     just before it, where the master has them); the run itself, its statistics, its events
     and its energy residual are those of the full record, and each recorded row is the full
     record's row, bit for bit."""
-    spy = _Spy(execution.MASTERS[algorithm])
-    monkeypatch.setitem(execution.MASTERS, algorithm, spy)
+    entry = ALGORITHMS[algorithm]
+    spy = _Spy(resolve(entry.factory))
+    monkeypatch.setitem(ALGORITHMS, algorithm, Algorithm(entry.settings, spy))
     full = _run(tmp_path, fmu_cache, _scene_for(algorithm, 1, hold), "full")
     steps, spy.steps = spy.steps, []
     thinned = _run(tmp_path, fmu_cache, _scene_for(algorithm, 7, hold), "thinned")
     assert full.status == thinned.status == "completed"
     assert [(s.end, s.h) for s in spy.steps] == [(s.end, s.h) for s in steps]
     assert len(steps) == full.stats.steps > 20
-    if algorithm in TOLERANCE_MASTERS:
+    if algorithm in tolerance_masters():
         assert sum(s.switched for s in steps) >= 10
     if hold == "midpoint":  # the single pass lands past the switch: no row before it
         assert any(s.left_row is not None for s in steps[6::7])  # a switch among those kept
@@ -174,9 +177,17 @@ class _HalfStepJacobi:
     """A master as docs/architecture.md's "Adding a master" describes one: Jacobi steps of half
     ``master.step``, with nothing but the stepping."""
 
-    def __init__(self, system, scene, stats) -> None:
-        self.system, self.stats = system, stats
-        self.h = 0.5 * scene.master.settings.step
+    name = "half-jacobi"
+
+    def __init__(self, settings: FixedStepSettings, system) -> None:
+        self.settings, self.system, self.stats = settings, system, StepStats()
+        self.h = 0.5 * settings.step
+
+    def setup(self) -> None:
+        pass
+
+    def start(self, t: float, stop: float) -> None:
+        pass
 
     def step(self, t: float, stop: float) -> MacroStep:
         h = stop - t if stop - t < 1.5 * self.h else self.h  # no sliver of a last step
@@ -191,9 +202,8 @@ class _HalfStepJacobi:
 def test_a_new_master_is_its_stepping_and_its_settings(tmp_path, fmu_cache, monkeypatch) -> None:
     """Registered with its settings, a master that only steps gets the rest from the loop:
     the stop time, the stop condition, the thinned record, the regime log and the counts."""
-    monkeypatch.setitem(SETTINGS, "half-jacobi", FixedStepSettings)
-    monkeypatch.setitem(execution.MASTERS, "half-jacobi", _HalfStepJacobi)
-    monkeypatch.setattr(scenario, "ALGORITHMS", (*ALGORITHMS, "half-jacobi"))
+    # One registry line (in orchestrator/masters/registry.py, a "module:function" factory).
+    monkeypatch.setitem(ALGORITHMS, "half-jacobi", Algorithm(FixedStepSettings, _HalfStepJacobi))
     overrides = {"scene.stop": "0.1 s", "output.every": 4}
     half = _run(
         tmp_path,
@@ -213,6 +223,12 @@ def test_a_new_master_is_its_stepping_and_its_settings(tmp_path, fmu_cache, monk
         "jacobi",
     )
     assert half.status == "completed" and half.stats.steps == 2000
+    # The summary records the settings that ran.
+    assert half.metadata["master_ran"] == {
+        "algorithm": "half-jacobi",
+        "step": 1e-4,
+        "call_timeout": 60.0,
+    }
     assert half.stats.do_steps == 2 * half.stats.steps
     assert len(half.data) == 1 + 2000 // 4 and half.signal("time")[-1] == pytest.approx(0.1)
     # Every 4th half step is every 2nd step of 0.05 ms: the same motion, but for rounding
@@ -227,5 +243,5 @@ def test_a_new_master_is_its_stepping_and_its_settings(tmp_path, fmu_cache, monk
         ),
         "stopped",
     )
-    assert stopped.stats.extra["stopped_by_condition"]
+    assert stopped.stats.stopped_by_condition
     assert 1.0 < stopped.signal("a.phi")[-1] < 1.0 + 10.0 * 0.5e-4

@@ -17,7 +17,8 @@ from typing import Any
 import pytest
 
 hypothesis = pytest.importorskip("hypothesis")
-from hypothesis import HealthCheck, given, settings  # noqa: E402
+from fuzz_inputs import COMMON, WEIRD_TEXT, assert_clear  # noqa: E402
+from hypothesis import given, settings  # noqa: E402
 from hypothesis import strategies as st  # noqa: E402
 
 from orchestrator.cli import main  # noqa: E402
@@ -28,10 +29,6 @@ RAW = {p.name: tomllib.loads(p.read_text()) for p in EXAMPLES}
 # Scenes short enough to run a few milliseconds of in the default suite.
 RUNNABLE = ["two_inertias.toml", "press_feed_run1.toml", "m739.toml"]
 
-WEIRD_TEXT = [
-    "nan s", "-1 s", "1e300 s", "inf rpm", "-inf", "abc", "", "0 s", "1e-300 ms", "5 kg",
-    "1e12 rpm", "-30000 rpm", "0.5 ms", "1 m", "nan", "1e-12 s", "NaN rad/s", "2 ** 2000",
-]  # fmt: skip
 INT64 = 2**63 - 1
 WEIRD = st.one_of(
     st.sampled_from(WEIRD_TEXT),
@@ -112,13 +109,6 @@ def mutated_scene(draw):
     return name, raw, overrides
 
 
-def assert_clear(code: int, err: str, allowed: tuple[int, ...]) -> None:
-    assert code in allowed, err
-    assert "Traceback" not in err, err
-    if code == 2:
-        assert err.startswith("error: ") and err.count("\n") == 1, err
-
-
 def exit_code(argv: list[str]) -> int:
     """The command's exit code, as the shell sees it: argparse's refusal of an argument (an
     override whose key starts with '-') exits from within main."""
@@ -154,13 +144,6 @@ def run_example(tmp_path: Path, capsys, example) -> None:
     if code == 0:  # a completed run has finite headline numbers (null: not finite)
         for q, entry in summary["headline"].items():
             assert entry["value"] is not None, q
-
-
-COMMON = dict(
-    deadline=None,
-    suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow],
-    derandomize=True,
-)
 
 
 @settings(max_examples=25, **COMMON)

@@ -17,9 +17,9 @@ from pathlib import Path
 import pytest
 
 hypothesis = pytest.importorskip("hypothesis")
+from fuzz_inputs import COMMON, WEIRD_TEXT, assert_clear  # noqa: E402
 from hypothesis import given, settings  # noqa: E402
 from hypothesis import strategies as st  # noqa: E402
-from test_fuzz_scenes import COMMON, WEIRD_TEXT, assert_clear  # noqa: E402
 
 from orchestrator.cli import main  # noqa: E402
 from orchestrator.scenario import load_scene  # noqa: E402

@@ -49,10 +49,10 @@ def _wait_for_handlers(proc: subprocess.Popen, timeout: float = 60.0) -> None:
         time.sleep(0.005)
 
 
-def interrupt_run(out: Path, delay: float, sig: int) -> tuple[int, str, float]:
+def interrupt_run(out: Path, delay: float, sig: int) -> tuple[int, str]:
     """Start ``mechcosim run scenarios/m739.toml``, send ``sig`` ``delay`` seconds after
-    it has taken over the signals; (exit code, stderr, seconds from the signal to the
-    exit)."""
+    it has taken over the signals; (exit code, stderr).  A command that does not exit
+    within 120 s of the signal fails the test (a hang, not a slow machine)."""
     proc = subprocess.Popen(
         [sys.executable, "-m", "orchestrator", "run", str(M739), "--no-progress"]
         + ["--output", str(out)],
@@ -63,7 +63,6 @@ def interrupt_run(out: Path, delay: float, sig: int) -> tuple[int, str, float]:
     )
     _wait_for_handlers(proc)
     time.sleep(delay)
-    sent = time.perf_counter()
     proc.send_signal(sig)
     try:
         _, err = proc.communicate(timeout=120)
@@ -71,7 +70,7 @@ def interrupt_run(out: Path, delay: float, sig: int) -> tuple[int, str, float]:
         proc.kill()
         proc.communicate()
         raise AssertionError(f"no exit within 120 s of {signal.Signals(sig).name}") from None
-    return proc.returncode, err, time.perf_counter() - sent
+    return proc.returncode, err
 
 
 def assert_interrupted(
@@ -149,13 +148,12 @@ def test_run_interrupted_at_a_random_moment(tmp_path: Path, sig: int) -> None:
     # machine); a signal after the run has completed leaves it completed, with exit 0.
     delay = random.uniform(0.0, 2.5)
     out = tmp_path / "out"
-    code, err, latency = interrupt_run(out, delay, sig)
+    code, err = interrupt_run(out, delay, sig)
     if code == 0:
         assert "Traceback" not in err, err[-2000:]
         assert json.loads((out / "summary.json").read_text())["status"] == "completed"
     else:
         assert_interrupted(out, code, err, sig, delay, started=False)
-    assert latency < 30.0
 
 
 @pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
@@ -164,9 +162,8 @@ def test_run_interrupted_while_its_modules_load(tmp_path: Path, sig: int) -> Non
     exit 130 / 143, never a traceback, never swallowed (the run going on to the end)."""
     for k, delay in enumerate((0.0, 0.02, 0.05, 0.1, 0.15)):
         out = tmp_path / f"run{k}"
-        code, err, latency = interrupt_run(out, delay, sig)
+        code, err = interrupt_run(out, delay, sig)
         assert_interrupted(out, code, err, sig, delay, started=False)
-        assert latency < 30.0
 
 
 @pytest.mark.slow
@@ -181,7 +178,7 @@ def test_run_interrupted_twenty_times(tmp_path: Path) -> None:
         sig = signal.SIGINT if k % 2 == 0 else signal.SIGTERM
         delay = rng.uniform(0.0, 9.0)
         out = tmp_path / f"run{k}"
-        code, err, _ = interrupt_run(out, delay, sig)
+        code, err = interrupt_run(out, delay, sig)
         if code == 0:  # the run had ended when the signal came
             assert "Traceback" not in err, err[-2000:]
             assert json.loads((out / "summary.json").read_text())["status"] == "completed"

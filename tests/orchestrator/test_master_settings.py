@@ -8,16 +8,14 @@ from pathlib import Path
 import pytest
 
 from orchestrator.errors import ScenarioError
+from orchestrator.lazy import resolve
 from orchestrator.master_settings import (
-    ALGORITHMS,
-    SETTING_KINDS,
-    SETTINGS,
     FixedStepSettings,
     MasterStepControl,
     RegimeAwareSettings,
     SinglePassControl,
 )
-from orchestrator.masters import MASTERS, TOLERANCE_MASTERS
+from orchestrator.masters.registry import ALGORITHMS, setting_kinds, tolerance_masters
 from orchestrator.scenario import load_scene
 
 SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
@@ -25,13 +23,16 @@ TWO = SCENARIOS / "two_inertias.toml"
 
 
 def test_every_master_has_settings_and_every_key_is_a_field() -> None:
-    assert set(ALGORITHMS) == set(MASTERS) == set(SETTINGS)
-    assert TOLERANCE_MASTERS == ("regime-aware",)
-    fields = {f.name for cls in SETTINGS.values() for f in dataclasses.fields(cls)}
-    assert set(SETTING_KINDS) <= fields
-    assert SETTING_KINDS["input_hold"].choices == ("auto", "start", "midpoint", "extrapolated")
-    assert SETTING_KINDS["max_iterations"].is_count
-    assert SETTING_KINDS["event_tolerance"].unit == "s"
+    assert set(ALGORITHMS) == {"jacobi", "gauss-seidel", "regime-aware"}
+    for entry in ALGORITHMS.values():  # every factory can be imported
+        assert callable(resolve(entry.factory))
+    assert tolerance_masters() == ("regime-aware",)
+    fields = {f.name for a in ALGORITHMS.values() for f in dataclasses.fields(a.settings)}
+    kinds = setting_kinds()
+    assert set(kinds) <= fields
+    assert kinds["input_hold"].choices == ("auto", "start", "midpoint", "extrapolated")
+    assert kinds["max_iterations"].is_count
+    assert kinds["event_tolerance"].unit == "s"
 
 
 def test_scene_settings_are_typed_with_defaults_filled_in() -> None:
@@ -146,7 +147,8 @@ def test_auto_input_hold_picks_the_single_pass_where_a_copy_judges_the_coupling(
             plots=False,
             compare_reference=False,
         )
-        chosen[name] = r.stats.extra["input_hold"]
+        chosen[name] = r.stats.input_hold
+        assert r.metadata["master_ran"]["input_hold"] == r.stats.input_hold
     assert chosen == {"m739": "extrapolated", "two": "midpoint"}
 
 
@@ -159,15 +161,13 @@ def test_auto_input_hold_picks_the_single_pass_where_a_copy_judges_the_coupling(
     ],
 )
 def test_the_single_pass_takes_no_longest_step_of_its_own(overrides: dict, longest: float) -> None:
-    from orchestrator.masters.regime_aware_choice import fmu_tolerance, regime_aware
-    from orchestrator.recorder import StepStats
+    from orchestrator.masters.regime_aware_choice import regime_aware
     from orchestrator.system import CoupledSystem
 
     scene = load_scene(M739, overrides)
     system = CoupledSystem(scene)
     try:
-        system.initialize(fmu_tolerance(system, scene))
-        master = regime_aware(system, scene, StepStats())
+        master = regime_aware(scene.master.settings, system)
         assert master.settings.longest_step == pytest.approx(longest, rel=1e-12)
     finally:
         system.close()
@@ -177,14 +177,15 @@ def test_error_scales_start_at_the_declared_nominals() -> None:
     """The press feed's drive and load declare 1 rad and 1 rad/s: the midpoint hold's
     relative error measures start there, not at zero (the load starts at rest)."""
     from orchestrator.masters.regime_aware_choice import regime_aware
-    from orchestrator.recorder import StepStats
     from orchestrator.system import CoupledSystem
 
     scene = load_scene(SCENARIOS / "press_feed_run1.toml", {"master.algorithm": "regime-aware"})
     system = CoupledSystem(scene)
     try:
+        master = regime_aware(scene.master.settings, system)
+        master.setup()
         system.initialize()
-        master = regime_aware(system, scene, StepStats())
+        master.start(scene.start, scene.stop)
         scales = {
             (system.names[i], system.real_names[i][k]): v
             for (i, k), v in master.scheme.held.out_scale.items()
@@ -207,15 +208,16 @@ def test_the_midpoint_hold_ramps_the_inputs_whose_receivers_take_a_rate(
     """The press feed's drive and load take ``torque_rate``: the midpoint corrector ramps
     their clutch torque; the start hold (and every other master) leaves it held."""
     from orchestrator.masters.regime_aware_choice import regime_aware
-    from orchestrator.recorder import StepStats
     from orchestrator.system import CoupledSystem
 
     overrides = {"master.algorithm": "regime-aware", "master.input_hold": hold}
     scene = load_scene(SCENARIOS / "press_feed_run1.toml", overrides)
     system = CoupledSystem(scene)
     try:
+        master = regime_aware(scene.master.settings, system)
+        master.setup()
         system.initialize()
-        master = regime_aware(system, scene, StepStats())
+        master.start(scene.start, scene.stop)
         ramps = master.scheme.ramps
         assert {system.names[j] for j, _, _ in ramps} == ramped
         for j, k, _ in ramps:

@@ -7,6 +7,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from scene_run import run_file
 
 from orchestrator.run import run_scene
 from orchestrator.scenario import load_scene
@@ -16,10 +17,7 @@ STOP_AT_ONE_RADIAN = {"signal": "a.phi", "above": "1 rad"}
 
 
 def run(tmp_path, fmu_cache, **overrides):
-    scene = load_scene(SCENE, overrides)
-    return run_scene(
-        scene, output_dir=tmp_path / "run", cache_dir=fmu_cache, show_progress=False, plots=False
-    )
+    return run_file(SCENE, tmp_path / "run", overrides)
 
 
 def test_error_follows_the_tolerance_with_inputs_held_at_the_step_start(
@@ -73,10 +71,10 @@ def test_stop_condition_is_landed_on_exactly(tmp_path, fmu_cache) -> None:
             "scene.stop_when": STOP_AT_ONE_RADIAN,
         },
     )
-    assert ours.status == "completed" and ours.stats.extra["stopped_by_condition"]
+    assert ours.status == "completed" and ours.stats.stopped_by_condition
     assert ours.signal("a.phi")[-1] == pytest.approx(1.0, abs=1e-9)
     fixed = run(tmp_path, fmu_cache, **{"scene.stop_when": STOP_AT_ONE_RADIAN})
-    assert fixed.stats.extra["stopped_by_condition"]
+    assert fixed.stats.stopped_by_condition
     overshoot = fixed.signal("a.phi")[-1] - 1.0
     assert 0.0 < overshoot < 10.0 * 1e-4  # at most one step of about 10 rad/s x 0.1 ms
 

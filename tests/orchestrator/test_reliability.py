@@ -57,7 +57,9 @@ def test_a_non_finite_output_fails_the_run_naming_variable_and_time(
         return row
 
     monkeypatch.setattr(CoupledSystem, "record_row", overflowing)
-    result = run_scene(load_scene(TWO, SHORT), output_dir=tmp_path, show_progress=False)
+    result = run_scene(
+        load_scene(TWO, SHORT), output_dir=tmp_path, show_progress=False, plots=False
+    )
     assert result.status == "failed"
     assert "a.w is inf, not finite" in result.message and "t = 0.005 s" in result.message
     summary = json.loads((tmp_path / "summary.json").read_text())  # strict JSON: no inf
@@ -99,7 +101,9 @@ def test_stalled_m739_reports_no_trajectory_error_instead_of_extrapolating(
     tmp_path: Path,
 ) -> None:
     stall = {"parameters.mu": 0.18, "fmus.verge.parameters.mu1": 0.18, "scene.stop": "20 ms"}
-    result = run_scene(load_scene(M739, stall), output_dir=tmp_path, show_progress=False)
+    result = run_scene(
+        load_scene(M739, stall), output_dir=tmp_path, show_progress=False, plots=False
+    )
     assert result.status == "completed"
     assert "stalled" in result.headline["not_armed_reason"]["value"]
     assert math.isnan(result.accuracy["trajectory_error"])  # was 1.1e+294
@@ -122,7 +126,9 @@ def test_stale_lock_of_a_dead_process_is_taken_over(tmp_path: Path) -> None:
     dead = subprocess.Popen([sys.executable, "-c", "pass"])
     dead.wait()
     (tmp_path / LOCK_NAME).write_text(json.dumps({"pid": dead.pid, "host": "here"}))
-    result = run_scene(load_scene(TWO, SHORT), output_dir=tmp_path, show_progress=False)
+    result = run_scene(
+        load_scene(TWO, SHORT), output_dir=tmp_path, show_progress=False, plots=False
+    )
     assert result.status == "completed"
     assert not (tmp_path / LOCK_NAME).exists()
 
@@ -130,7 +136,7 @@ def test_stale_lock_of_a_dead_process_is_taken_over(tmp_path: Path) -> None:
 # -- 4. analyses never crash after a run -----------------------------------------------------
 def test_press_feed_shorter_than_a_cycle_says_what_is_missing(tmp_path: Path) -> None:
     scene = load_scene(PRESS, {"scene.stop": "5 ms"})
-    result = run_scene(scene, output_dir=tmp_path, show_progress=False)
+    result = run_scene(scene, output_dir=tmp_path, show_progress=False, plots=False)
     assert result.status == "completed"
     assert any("less than one crank cycle" in n for n in result.notes), result.notes
     summary = json.loads((tmp_path / "summary.json").read_text())
@@ -140,7 +146,7 @@ def test_press_feed_shorter_than_a_cycle_says_what_is_missing(tmp_path: Path) ->
 
 def test_m739_without_spin_has_no_reference_trajectory_but_ends(tmp_path: Path) -> None:
     scene = load_scene(M739, {"parameters.spin": "0 rpm", "scene.stop": "5 ms"})
-    result = run_scene(scene, output_dir=tmp_path, show_progress=False)
+    result = run_scene(scene, output_dir=tmp_path, show_progress=False, plots=False)
     assert result.status == "completed"
     assert "trajectory_error" in result.accuracy  # KeyError 't' before
     assert (tmp_path / "summary.json").exists()

@@ -27,9 +27,32 @@ def test_one_value_reaches_every_fmu_that_takes_it() -> None:
 
 
 def test_the_families_declare_them() -> None:
-    shared = shared_parameters()
+    shared = shared_parameters(("m739", "clock_train"))
     assert shared["spin"].components == {"GearTrain", "ClockGearTrain", "VergeEscapement"}
     assert shared["mu"].components == {"GearTrain", "ClockGearTrain", "VergeEscapement"}
+    assert shared_parameters(("m739",))["spin"].components == {"GearTrain", "VergeEscapement"}
+    assert shared_parameters(("press_feed",)) == {}
+
+
+def test_only_the_scene_families_share_their_parameters(tmp_path: Path) -> None:
+    """Without the M739 family, the train and the verge share nothing: each FMU's own
+    friction coefficient is its own (with the family, stating it per FMU is refused)."""
+    text = M739.read_text()
+    own = (
+        text[: text.index("[report]")]
+        .replace(text[text.index("[parameters]") : text.index("[fmus.train]")], "")
+        .replace(
+            'component = "GearTrain"\n', 'component = "GearTrain"\nparameters = { mu = 0.2 }\n'
+        )
+    )
+    path = tmp_path / "m739_no_family.toml"
+    path.write_text(own)
+    scene = load_scene(path)
+    assert scene.family is None and scene.fmus["train"].parameters["mu"] == 0.2
+    assert "mu" not in scene.fmus["verge"].parameters
+    path.write_text(own + '\n[report]\nfamily = "m739"\n')
+    with pytest.raises(ScenarioError, match=r"\[fmus\.train\.parameters\.mu\].*state it once"):
+        load_scene(path)
 
 
 def test_a_scene_in_the_old_form_is_refused_with_the_new_key(tmp_path: Path) -> None:

@@ -7,10 +7,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from scene_run import run_file
 
 from orchestrator.errors import ScenarioError
 from orchestrator.model_info import VariableInfo
-from orchestrator.run import run_scene
 from orchestrator.scenario import load_scene
 from orchestrator.signals import InputSignals, Reader, Signal, read_signal
 
@@ -42,10 +42,7 @@ def write(tmp_path: Path, text: str, name: str = "scene.toml") -> Path:
 
 
 def run(tmp_path: Path, path: Path, **overrides):
-    scene = load_scene(path, overrides)
-    result = run_scene(scene, output_dir=tmp_path / "out", show_progress=False)
-    assert result.status == "completed", result.message
-    return result
+    return run_file(path, tmp_path / "out", overrides, completed=True)
 
 
 def motion(signal: Signal, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -392,3 +389,50 @@ def test_exports_refuse_what_they_cannot_carry(tmp_path: Path) -> None:
     path = write(tmp_path, scene_text('{ step = "1.5 ms", from = 0.0, to = 1.0 }'))
     with pytest.raises(ScenarioError, match=r"1.5 ms|0.0015 s is not on libcosim's base step"):
         export_osp(load_scene(path), tmp_path / "osp")
+
+
+def test_fmpy_input_file_without_units_takes_the_declared_units(tmp_path: Path) -> None:
+    """FMPy's own input CSV (``time,tau``, no units): time in s, tau in the input's
+    declared unit (N.m), with a note; the same signal as the file with units."""
+
+    (tmp_path / "fmpy.csv").write_text("time,tau\n0,0\n0.001,0.002\n")
+    (tmp_path / "units.csv").write_text("time [ms],tau [N*m]\n0,0\n1,0.002\n")
+    signals = {}
+    for name in ("fmpy", "units"):
+        scene = tmp_path / f"{name}.toml"
+        scene.write_text(_FILE_SCENE.format(name=name, file=f"{name}.csv"))
+        loaded = load_scene(scene)
+        signals[name] = loaded.fmus["a"].signals["tau"]
+    assert signals["fmpy"].times == signals["units"].times == (0.0, 0.001)
+    assert signals["fmpy"].values == signals["units"].values == (0.0, 0.002)
+    result = run_file(tmp_path / "fmpy.toml", tmp_path / "out", reference=False)
+    note = (
+        "signal a.tau: a header without units (FMPy's input format): time in s, values in "
+        "the input's declared unit N.m"
+    )
+    assert note in result.notes
+
+
+def test_a_header_mixing_units_and_none_is_still_refused(tmp_path: Path) -> None:
+    (tmp_path / "mixed.csv").write_text("time [s],tau\n0,0\n")
+    scene = tmp_path / "mixed.toml"
+    scene.write_text(_FILE_SCENE.format(name="mixed", file="mixed.csv"))
+    with pytest.raises(ScenarioError) as err:
+        load_scene(scene)
+    assert "line 1: column 'tau' has no unit; expected 'name [unit]'" in str(err.value)
+
+
+_FILE_SCENE = """
+[scene]
+name = "{name}"
+stop = "2 ms"
+
+[fmus.a]
+component = "Inertia"
+parameters = {{ J = "1e-4 kg*m^2" }}
+inputs = {{ tau = {{ file = "{file}" }} }}
+
+[master]
+algorithm = "jacobi"
+step = "0.5 ms"
+"""

@@ -13,6 +13,8 @@ import pytest
 
 from orchestrator.run import reference_of
 from orchestrator.scenario import load_scene
+from orchestrator.scenes.family import Outcome
+from orchestrator.scenes.m739 import TURNS
 from orchestrator.scenes.m739.monolithic import REFERENCE_TOLERANCE
 from orchestrator.studies.jobs import Job, JobResult
 from orchestrator.studies.monolithic_curve import (
@@ -57,7 +59,7 @@ def test_time_in_window_and_the_ratio_of_a_point() -> None:
     assert math.isnan(time_in_window(curve, 5e-7))
     assert math.isnan(time_in_window(None, 5e-5))
     assert curve.relative_error(25.0 * (1 + 3e-5)) == pytest.approx(3e-5, rel=1e-9)
-    row = _row("regime-aware", 1e-3, wall=0.63, turns_error=5e-5, mono=0.35)
+    row = _row("regime-aware", 1e-3, wall=0.63, quantity_error=5e-5, mono=0.35)
     assert row.monolithic_ratio == pytest.approx(1.8)
 
 
@@ -68,8 +70,8 @@ def test_monolithic_curve_times_each_tolerance_against_the_truth() -> None:
     def model(tolerance: float):
         calls.append(tolerance)
         if tolerance == 1e-2:
-            return SimpleNamespace(armed=False, turns=None, reason="stalled")
-        return SimpleNamespace(armed=True, turns=truth * (1 + 10 * tolerance), reason="")
+            return Outcome(math.nan, "stalled")
+        return Outcome(truth * (1 + 10 * tolerance), "armed")
 
     curve = monolithic_curve(model, (1e-2, 1e-4, 1e-6))
     assert calls == [1e-12, 1e-2, 1e-4, 1e-6]  # each once: retime times them again
@@ -78,8 +80,8 @@ def test_monolithic_curve_times_each_tolerance_against_the_truth() -> None:
     assert [p.error for p in curve.points[1:]] == pytest.approx([1e-3, 1e-5], rel=1e-6)
     assert all(p.wall_time > 0 for p in curve.points)
     # A truth that does not arm (a stop before arming) gives the reason, not a curve.
-    never = monolithic_curve(lambda tolerance: SimpleNamespace(armed=False, reason="stop"), (1e-3,))
-    assert never == "did not arm at tolerance 1e-12 (stop): no turns error"
+    never = monolithic_curve(lambda tolerance: Outcome(math.nan, "stop"), (1e-3,))
+    assert never == "gave no value at tolerance 1e-12 (stop): no error"
 
 
 def test_retime_runs_each_tolerance_again_and_keeps_the_least_time() -> None:
@@ -87,7 +89,7 @@ def test_retime_runs_each_tolerance_again_and_keeps_the_least_time() -> None:
 
     def model(tolerance: float):
         calls.append(tolerance)
-        return SimpleNamespace(armed=True, turns=1.0, reason="")
+        return Outcome(1.0, "armed")
 
     slow = MonolithicCurve(
         1.0, 5.0, [MonolithicPoint(1e-3, 1e9, 2e-4), MonolithicPoint(1e-5, 1e9, 3e-6)]
@@ -111,7 +113,7 @@ def test_the_report_times_the_curve_and_the_masters_in_alternate_rounds(
     order = []
     curve = MonolithicCurve(1.0, 1.0, [MonolithicPoint(1e-3, 1.0, 1e-4)])
     monkeypatch.setattr(wp, "reference_of", lambda scene: SimpleNamespace(wall_time=1.0))
-    monkeypatch.setattr(wp, "monolithic_model", lambda scene: lambda tol: None)
+    monkeypatch.setattr(wp, "monolithic_model", lambda scene: (TURNS, lambda tol: None))
     monkeypatch.setattr(wp, "monolithic_curve", lambda *a: order.append("curve") or curve)
     monkeypatch.setattr(wp, "retime", lambda c, m: order.append("retime") or c)
     monkeypatch.setattr(wp, "run_jobs", lambda jobs, **k: order.append("masters") or [])
@@ -128,10 +130,10 @@ def test_the_report_times_the_curve_and_the_masters_in_alternate_rounds(
     assert order == ["curve", "masters", "masters"]
 
 
-def _row(master, tol, wall, turns_error, mono=math.nan, setting="tolerance") -> Row:
+def _row(master, tol, wall, quantity_error, mono=math.nan, setting="tolerance") -> Row:
     job = Job("scene.toml", {}, "out", master)
     result = JobResult(job, "completed", "", {}, {"do_steps": 10}, [], np.empty((0, 1)), [])
-    return Row(master, setting, tol, result, {}, turns_error, mono, wall)
+    return Row(master, setting, tol, result, {}, quantity_error, mono, wall)
 
 
 def test_summary_flags_errors_over_the_tolerance_and_ratios_over_2x() -> None:
@@ -143,7 +145,8 @@ def test_summary_flags_errors_over_the_tolerance_and_ratios_over_2x() -> None:
         _row(ONE_PASS, 1e-1, 0.6, 4e-3),  # outside the window: no ratio
         _row("jacobi", 1e-6, 2.0, 1e-2, setting="step"),
     ]
-    text = summary(rows, curve, SimpleNamespace(name="m739", reference="m739"), 1.0)
+    scene = SimpleNamespace(name="m739", reference="m739")
+    text = summary(rows, curve, scene, 1.0, headline=TURNS)
     assert (
         "| regime-aware | tolerance | 0.0001 | completed | 1.5 | 0.0003 | 0.5 | 3 | **NO** |"
         in (text)
@@ -161,17 +164,17 @@ def test_summary_flags_errors_over_the_tolerance_and_ratios_over_2x() -> None:
     [("m739.toml", {"scene.stop": "5 ms"}), ("clock_train_sa.toml", SHORT_CLOCK)],
 )
 def test_the_monolithic_model_is_the_references(scene_file, overrides, fmu_cache) -> None:
-    """The curve's model runs the reference's physics: at the reference's tolerance it gives
-    the reference's headline values exactly (M739 cut at 5 ms: forces and impacts)."""
+    """The family's model runs the reference's physics: at the reference's tolerance it
+    gives the reference's turns to arm exactly (M739 cut at 5 ms: neither arms)."""
     scene = load_scene(SCENARIOS / scene_file, overrides, cache_dir=fmu_cache)
-    model = monolithic_model(scene)
-    assert model is not None
-    result, headline = model(REFERENCE_TOLERANCE), reference_of(scene).headline
-    got = {"F23_max": result.f23_max, "PN_max": result.pn_max, "impacts": result.impacts}
-    if result.armed:
-        got["turns_to_arm"] = result.turns
-    assert got == {name: headline[name] for name in got}
-    assert result.impacts > 5 and ("turns_to_arm" in got) == ("clock" in scene_file)
+    found = monolithic_model(scene)
+    assert found is not None and found[0] == TURNS
+    outcome, headline = found[1](REFERENCE_TOLERANCE), reference_of(scene).headline
+    if "clock" in scene_file:
+        assert outcome == Outcome(headline["turns_to_arm"], "armed")
+    else:
+        assert math.isnan(outcome.value) and outcome.reason == "stop time reached"
+        assert "turns_to_arm" not in headline
 
 
 def test_no_monolithic_model_without_a_family_model() -> None:
@@ -208,12 +211,12 @@ def test_precision_run_on_a_short_clock_train_writes_the_monolithic_columns(
     # The master's turns error against the same truth as the curve's, in the window (2.7e-5
     # measured), and its ratio read off the curve written beside it.
     scene = load_scene(SCENARIOS / "clock_train_sa.toml", SHORT_CLOCK, cache_dir=fmu_cache)
-    truth = monolithic_model(scene)(1e-12).turns
+    truth = monolithic_model(scene)[1](1e-12).value
     turns = ra.result.headline["turns_to_arm"]["value"]
-    assert ra.turns_error == pytest.approx(abs(turns - truth) / truth, rel=1e-12)
-    assert 1e-6 < ra.turns_error < 1e-3
+    assert ra.quantity_error == pytest.approx(abs(turns - truth) / truth, rel=1e-12)
+    assert 1e-6 < ra.quantity_error < 1e-3
     assert ra.within_tolerance == "yes"  # 2.7e-5 at tolerance 1e-2
-    assert ra.monolithic_time == envelope_time(curve_points, ra.turns_error)
+    assert ra.monolithic_time == envelope_time(curve_points, ra.quantity_error)
     assert ra.monolithic_ratio == pytest.approx(ra.wall_time / ra.monolithic_time)
     record = next(r for r in records if r["master"] == "regime-aware")
     assert float(record["monolithic_ratio"]) == pytest.approx(ra.monolithic_ratio)

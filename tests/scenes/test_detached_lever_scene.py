@@ -9,12 +9,13 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from scene_run import run_file
 
 from components.detached_lever import DetachedLever
 from components.detached_lever_data import TABLE_I
 from components.detached_lever_design import symmetric_friction
 from orchestrator.errors import ScenarioError
-from orchestrator.run import RunResult, run_scene
+from orchestrator.run import RunResult
 from orchestrator.scenario import load_scene
 from orchestrator.scenes.detached_lever.lever import lever_scene
 
@@ -41,16 +42,13 @@ def friction(coulomb: float) -> dict[str, float]:
     return {f"fmus.lever.parameters.{k}": v for k, v in symmetric_friction(coulomb).items()}
 
 
-def run(path: Path, out: Path, cache: Path, **overrides) -> RunResult:
-    scene = load_scene(path, overrides)
-    result = run_scene(scene, output_dir=out, cache_dir=cache, show_progress=False)
-    assert result.status == "completed", result.message
-    return result
+def run(path: Path, out: Path, cache: Path, plots: bool = False, **overrides) -> RunResult:
+    return run_file(path, out, overrides, plots=plots, completed=True)
 
 
 @pytest.fixture(scope="module")
 def decay(tmp_path_factory, fmu_cache) -> RunResult:
-    return run(DECAY, tmp_path_factory.mktemp("lever_decay"), fmu_cache)
+    return run(DECAY, tmp_path_factory.mktemp("lever_decay"), fmu_cache, plots=True)
 
 
 # -- the thesis's phase-scheduled model: the worked example ------------------------------------
@@ -194,7 +192,7 @@ def _rate_case(unit: int, multiple: int) -> dict[str, object]:
 
 
 def test_rate_sweep_case_unit4(tmp_path, fmu_cache) -> None:
-    r = run(RATE, tmp_path, fmu_cache, **_rate_case(4, 2))
+    r = run(RATE, tmp_path, fmu_cache, plots=True, **_rate_case(4, 2))
     assert r.value("table_i_unit") == 4
     assert r.value("load_multiple") == pytest.approx(2.0, rel=1e-12)
     # the thesis's computed unit curve at Table I's (C/omega0, K) = (0.050, 0.510), derived

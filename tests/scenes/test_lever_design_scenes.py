@@ -48,7 +48,9 @@ def test_the_example_scenes_keep_every_rule() -> None:
 
 def test_the_asymmetric_deck_runs_in_agreement_with_its_reference(tmp_path, fmu_cache) -> None:
     scene = load_scene(ASYMMETRIC)
-    result = run_scene(scene, output_dir=tmp_path, cache_dir=fmu_cache, show_progress=False)
+    result = run_scene(
+        scene, output_dir=tmp_path, cache_dir=fmu_cache, show_progress=False, plots=False
+    )
     assert result.status == "completed", result.message
     # Its cards as typed (s^-2), F(n) = R(n) + X(n), through the Table III cycle map
     forcing = (280.0, 320.0 + 143.41, 280.0 - 1245.8, 280.0 - 1100.0, 280.0,
@@ -93,7 +95,9 @@ def _runs_in_agreement_or_is_refused(tmp_path: Path, fmu_cache: Path, data: st.D
         assert "design rule '" in str(exc)  # refused by a named rule, nothing else
         return "refused"
     assert violations(scene_design(scene, "lever")) == []
-    result = run_scene(scene, output_dir=tmp_path / "p", cache_dir=fmu_cache, show_progress=False)
+    result = run_scene(
+        scene, output_dir=tmp_path / "p", cache_dir=fmu_cache, show_progress=False, plots=False
+    )
     assert result.status == "completed", result.message
     assert result.accuracy["trajectory_error"] < 1e-8
     # every cycle's amplitude; the steady state too where the run's limit is exact (the

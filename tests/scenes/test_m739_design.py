@@ -12,6 +12,7 @@ import matplotlib
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from scene_run import run_file
 
 from components.m739_data import M739
 from components.sanda2v_deck import BY_NAME, violations
@@ -29,15 +30,7 @@ DECK_SCENE = SCENARIOS / "m739_from_deck.toml"
 
 
 def _run(path: Path, out: Path, cache: Path, reference: bool = False, **overrides):
-    scene = load_scene(path, overrides, cache_dir=cache)
-    return run_scene(
-        scene,
-        output_dir=out,
-        cache_dir=cache,
-        show_progress=False,
-        compare_reference=reference,
-        plots=False,
-    )
+    return run_file(path, out, overrides, reference=reference)
 
 
 def test_the_deck_from_a_file_reproduces_the_m739_run_to_the_bit(tmp_path, fmu_cache) -> None:
@@ -178,7 +171,9 @@ def test_designs_near_the_m739_run_in_agreement_or_are_refused(tmp_path, fmu_cac
         assert "design rule '" in str(exc)  # refused by a named rule, nothing else
         return
     assert violations(scene_design(scene)) == []
-    result = run_scene(scene, output_dir=tmp_path / "p", cache_dir=fmu_cache, show_progress=False)
+    result = run_scene(
+        scene, output_dir=tmp_path / "p", cache_dir=fmu_cache, show_progress=False, plots=False
+    )
     assert result.status == "completed", result.message
     assert result.accuracy["headline_error.turns_to_arm"] < 2e-4
     assert result.accuracy["event_count_difference"] == 0

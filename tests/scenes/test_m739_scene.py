@@ -7,31 +7,28 @@ import csv
 from pathlib import Path
 
 import pytest
+from scene_run import run_file
 
 from components.m739_data import LBF
-from orchestrator.run import run_scene
-from orchestrator.scenario import load_scene
 
 SCENE = Path(__file__).resolve().parents[2] / "scenarios" / "m739.toml"
 
 
-def run(tmp_path: Path, fmu_cache: Path, name: str, **overrides):
-    scene = load_scene(SCENE, overrides)
-    return run_scene(scene, output_dir=tmp_path / name, cache_dir=fmu_cache, show_progress=False)
+def run(tmp_path: Path, fmu_cache: Path, name: str, plots: bool = False, **overrides):
+    return run_file(SCENE, tmp_path / name, overrides, plots=plots)
 
 
 @pytest.fixture(scope="module")
 def default_run(tmp_path_factory, fmu_cache):
     """The scene as written: the single pass ("auto", the verge keeps a copy of the wheel)."""
-    return run(tmp_path_factory.mktemp("m739"), fmu_cache, "default")
+    return run(tmp_path_factory.mktemp("m739"), fmu_cache, "default", plots=True)
 
 
 @pytest.fixture(scope="module")
 def midpoint_run(tmp_path_factory, fmu_cache):
     """The scene under the regime-aware master's other scheme."""
-    return run(
-        tmp_path_factory.mktemp("m739"), fmu_cache, "midpoint", **{"master.input_hold": "midpoint"}
-    )
+    hold = {"master.input_hold": "midpoint"}
+    return run(tmp_path_factory.mktemp("m739"), fmu_cache, "midpoint", plots=True, **hold)
 
 
 #: The validations below hold for both schemes of the regime-aware master (the midpoint
@@ -76,8 +73,8 @@ def test_cosimulation_matches_the_monolithic_reference(request, scheme) -> None:
 @pytest.mark.slow
 def test_the_single_pass_is_the_cheaper_at_the_same_accuracy(default_run, midpoint_run) -> None:
     # Counted, not timed: 1676 doSteps against 20448 (turns errors 2.2e-6 and 8.0e-5).
-    assert default_run.stats.extra["input_hold"] == "extrapolated"
-    assert midpoint_run.stats.extra["input_hold"] == "midpoint"
+    assert default_run.stats.input_hold == "extrapolated"
+    assert midpoint_run.stats.input_hold == "midpoint"
     assert default_run.stats.do_steps < 0.2 * midpoint_run.stats.do_steps
 
 
@@ -115,8 +112,8 @@ def test_a_coarse_tolerance_stays_accurate(tmp_path, fmu_cache, default_run) -> 
     # targets ask (measured 7.5e-5: steps bounded by the switches alone, the train's reduced
     # model in the verge), in fewer steps than at the scene's (630 against 765).
     single = run(tmp_path, fmu_cache, "coarse_single_pass", **{"master.tolerance": 1e-2})
-    assert single.stats.extra["input_hold"] == default_run.stats.extra["input_hold"]
-    assert single.stats.extra["input_hold"] == "extrapolated"
+    assert single.stats.input_hold == default_run.stats.input_hold
+    assert single.stats.input_hold == "extrapolated"
     assert single.accuracy["headline_error.turns_to_arm"] < 1e-4
     assert single.stats.steps < default_run.stats.steps
 

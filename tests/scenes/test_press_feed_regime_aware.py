@@ -2,7 +2,9 @@
 
 The regime-aware master lands on each engagement (windup = 0), break-away and stop of the
 brake, and rocker reversal, so the run's regime log can be compared switch by switch with
-the monolithic reference's located events.
+the monolithic reference's located events.  Each test runs under both of its schemes: the
+midpoint hold ("auto" keeps it on the press feed) and the single pass (``input_hold =
+"extrapolated"``, in the slow suite), to the same bounds.
 
 Stated tolerances at master tolerance 1e-3 (measured in brackets):
 Run 1 — event times 1e-4 s [4.4e-5 s], feed length 2e-4 relative [4.8e-5], mean windup
@@ -34,26 +36,29 @@ from orchestrator.scenes.press_feed.report import (
 )
 
 SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
-REGIME_AWARE = {
+MIDPOINT = {
     "master.algorithm": "regime-aware",
     "master.first_step": "1 us",
     "master.tolerance": 1e-3,
 }
+SINGLE_PASS = {**MIDPOINT, "master.input_hold": "extrapolated"}
+#: Both schemes, the single pass in the slow suite (the default stays under 2 minutes).
+SCHEMES = [
+    pytest.param(MIDPOINT, id="midpoint"),
+    pytest.param(SINGLE_PASS, id="single-pass", marks=pytest.mark.slow),
+]
+SLOW_SCHEMES = [pytest.param(*p.values, id=p.id, marks=pytest.mark.slow) for p in SCHEMES]
 GRAZING = ("clutch", "engaged", "overrun")
 
 
 @pytest.fixture(scope="module")
-def runs(fmu_cache, tmp_path_factory):
-    done: dict[str, tuple[RunResult, object]] = {}
+def runs(scene_runs):
+    """(run, its reference) of a press feed scene under a scheme, each made once."""
 
-    def get(name: str) -> tuple[RunResult, object]:
-        if name not in done:
-            scene = load_scene(SCENARIOS / name, REGIME_AWARE)
-            out = tmp_path_factory.mktemp(scene.name)
-            result = run_scene(scene, out, cache_dir=fmu_cache, show_progress=False, plots=False)
-            assert result.reference is not None, result.notes
-            done[name] = (result, result.reference)
-        return done[name]
+    def get(name: str, scheme: dict) -> tuple[RunResult, object]:
+        result = scene_runs(name, scheme)
+        assert result.reference is not None, result.notes
+        return result, result.reference
 
     return get
 
@@ -69,9 +74,9 @@ def test_run2_scene_defaults_to_the_regime_aware_master():
     assert load_scene(SCENARIOS / "press_feed_run2.toml").master.algorithm == "regime-aware"
 
 
-@pytest.mark.slow  # in the slow suite (CI runs it): the default stays under 2 minutes
-def test_run1_switches_are_located(runs):
-    r, ref = runs("press_feed_run1.toml")
+@pytest.mark.parametrize("scheme", SLOW_SCHEMES)
+def test_run1_switches_are_located(runs, scheme):
+    r, ref = runs("press_feed_run1.toml", scheme)
     assert r.status == "completed", r.message
     run_events, ref_events = _grouped(r.events), _grouped(ref.events)
     # Regime names come from the components: the run's log and the reference's match key by key.
@@ -81,8 +86,9 @@ def test_run1_switches_are_located(runs):
     assert r.stats.events >= len(ref.events)
 
 
-def test_run1_against_the_reference(runs):
-    r, _ = runs("press_feed_run1.toml")
+@pytest.mark.parametrize("scheme", SCHEMES)
+def test_run1_against_the_reference(runs, scheme):
+    r, _ = runs("press_feed_run1.toml", scheme)
     acc = r.accuracy
     assert acc["headline_error.feed_length_mean"] < 2e-4
     assert acc["headline_error.mean_windup_feed"] < 1e-3
@@ -91,17 +97,18 @@ def test_run1_against_the_reference(runs):
     assert r.value("energy_residual") < 1e-3
 
 
-def test_run1_four_regimes_in_every_cycle(runs):
-    r, _ = runs("press_feed_run1.toml")
+@pytest.mark.parametrize("scheme", SCHEMES)
+def test_run1_four_regimes_in_every_cycle(runs, scheme):
+    r, _ = runs("press_feed_run1.toml", scheme)
     for seq in run_regime_sequences(r.scene, r.header, r.data):
         assert set(seq) == {WINDUP, FEED, UNWIND, OVERRUN}, seq
         assert seq[-1] == OVERRUN
 
 
 # Run 2 under the regime-aware master takes about 17 s: a long validation run.
-@pytest.mark.slow
-def test_run2_finds_the_grazing_disengagements(runs):
-    r, ref = runs("press_feed_run2.toml")
+@pytest.mark.parametrize("scheme", SLOW_SCHEMES)
+def test_run2_finds_the_grazing_disengagements(runs, scheme):
+    r, ref = runs("press_feed_run2.toml", scheme)
     assert r.status == "completed", r.message
     assert ref.headline["disengagements"] == 2.0
     assert r.value("disengagements") == ref.headline["disengagements"]
@@ -118,9 +125,9 @@ def test_run2_finds_the_grazing_disengagements(runs):
             assert max(errors) < 1e-4, (key, errors)
 
 
-@pytest.mark.slow  # in the slow suite (CI runs it): the default stays under 2 minutes
-def test_run2_feed_still_ends_in_the_thesis_regimes(runs):
-    r, ref = runs("press_feed_run2.toml")
+@pytest.mark.parametrize("scheme", SLOW_SCHEMES)
+def test_run2_feed_still_ends_in_the_thesis_regimes(runs, scheme):
+    r, ref = runs("press_feed_run2.toml", scheme)
     assert r.accuracy["headline_error.feed_length_mean"] < 1e-3
     # A feed interrupted by a disengagement: the windup during feed stays below the
     # steady value (T_b / K_sp)^(2/3) of the thesis's eq. (V10).
@@ -130,6 +137,17 @@ def test_run2_feed_still_ends_in_the_thesis_regimes(runs):
     assert math.isclose(r.value("mean_windup_feed"), ref.headline["mean_windup_feed"], rel_tol=3e-3)
     seqs = run_regime_sequences(r.scene, r.header, r.data)
     assert any(seq.count(FEED) > 1 for seq in seqs), seqs  # feed, overrun, feed again
+
+
+@pytest.mark.slow
+def test_run3_under_the_single_pass_against_its_reference(runs):
+    # Run 3 has no regime-aware test of its own: the bounds of Run 1's.
+    r, _ = runs("press_feed_run3.toml", SINGLE_PASS)
+    assert r.status == "completed", r.message
+    acc = r.accuracy
+    assert acc["trajectory_error"] < 5e-3
+    assert acc["event_time_error"] < 1e-4
+    assert r.value("energy_residual") < 1e-3
 
 
 @pytest.mark.slow

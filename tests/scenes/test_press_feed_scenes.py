@@ -72,18 +72,10 @@ def _windup_error(scene, run: RunResult, ref) -> float:
 
 
 @pytest.fixture(scope="module")
-def runs(fmu_cache, tmp_path_factory):
-    """Each scene run once under fixed-step Gauss-Seidel (with the reference), on demand."""
-    done: dict[str, RunResult] = {}
-
-    def get(name: str) -> RunResult:
-        if name not in done:
-            scene = load_scene(SCENARIOS / name, FIXED_STEP.get(name))
-            out = tmp_path_factory.mktemp(scene.name)
-            done[name] = run_scene(scene, out, cache_dir=fmu_cache, show_progress=False)
-        return done[name]
-
-    return get
+def runs(scene_runs):
+    """Each scene run once under fixed-step Gauss-Seidel (with the reference and its plot),
+    on demand."""
+    return lambda name: scene_runs(name, FIXED_STEP.get(name), plots=True)
 
 
 @pytest.fixture(scope="module")

@@ -1,48 +1,28 @@
 """The regime-aware master's single-pass scheme (``master.input_hold = "extrapolated"``):
 each FMU stepped once per macro step, switches landed on by early return.
 
-Here: the cost of a landing counted in doSteps (default suite), and the press feed Runs
-1-3 with the assertions of the regime-aware press feed tests (slow), where "auto" keeps the
-midpoint hold.  M739 and the clock train run it by default: their scene tests
-(tests/scenes/test_m739_scene.py, test_clock_gear_train.py) check both schemes, and the
-stability suite (tests/orchestrator/test_stability.py) runs every case under both.
+Here: the cost of a landing counted in doSteps (default suite).  The press feed runs
+under it with the assertions of its midpoint hold ("auto" keeps the midpoint there):
+tests/scenes/test_press_feed_regime_aware.py runs each of them under both schemes.  M739
+and the clock train run it by default: their scene tests (tests/scenes/test_m739_scene.py,
+test_clock_gear_train.py) check both schemes, and the stability suite
+(tests/orchestrator/test_stability.py) runs every case under both.
 """
 
 from __future__ import annotations
 
-import math
-from collections import defaultdict
 from pathlib import Path
 
 import pytest
-
-from orchestrator.run import RunResult, run_scene
-from orchestrator.scenario import load_scene
-from orchestrator.scenes.press_feed.report import (
-    FEED,
-    OVERRUN,
-    UNWIND,
-    WINDUP,
-    feed_scene,
-    run_regime_sequences,
-)
+from scene_run import run_file
 
 SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
 SINGLE_PASS = {"master.algorithm": "regime-aware", "master.input_hold": "extrapolated"}
-#: The press feed's regime-aware settings in tests/scenes/test_press_feed_regime_aware.py.
-PRESS_FEED = {"master.first_step": "1 us", "master.tolerance": 1e-3}
 
 
 def run(tmp_path: Path, fmu_cache: Path, scene: str, reference: bool = True, **overrides):
-    loaded = load_scene(SCENARIOS / scene, {**SINGLE_PASS, **overrides})
-    return run_scene(
-        loaded,
-        output_dir=tmp_path,
-        cache_dir=fmu_cache,
-        show_progress=False,
-        compare_reference=reference,
-        plots=reference,
-    )
+    overrides = {**SINGLE_PASS, **overrides}
+    return run_file(SCENARIOS / scene, tmp_path, overrides, reference=reference, plots=reference)
 
 
 def test_a_switch_costs_one_doStep_of_each_fmu(tmp_path, fmu_cache) -> None:
@@ -58,112 +38,13 @@ def test_a_switch_costs_one_doStep_of_each_fmu(tmp_path, fmu_cache) -> None:
             reference=False,
             **{"master.tolerance": tol, "scene.stop": "4 ms"},
         )
-        extra = r.stats.extra
+        stats = r.stats
         assert r.status == "completed", r.message
-        assert extra["landings"] >= 20
-        assert extra["landing_pass_do_steps_max"] == 2
+        assert stats.landings >= 20
+        assert stats.landing_pass_do_steps_max == 2
         # Passes rejected by the error test on the way included: at most 4 passes.
-        assert extra["landing_do_steps_max"] <= 8
-        assert extra["landing_do_steps"] <= 2.5 * extra["landings"]
-
-
-@pytest.fixture(scope="module")
-def press(fmu_cache, tmp_path_factory):
-    """Press feed runs (and their references) under the single pass at the settings of
-    tests/scenes/test_press_feed_regime_aware.py, each run once."""
-    done: dict[str, RunResult] = {}
-
-    def get(name: str) -> RunResult:
-        if name not in done:
-            scene = load_scene(SCENARIOS / name, {**SINGLE_PASS, **PRESS_FEED})
-            out = tmp_path_factory.mktemp(scene.name)
-            result = run_scene(scene, out, cache_dir=fmu_cache, show_progress=False, plots=False)
-            assert result.reference is not None, result.notes
-            done[name] = result
-        return done[name]
-
-    return get
-
-
-def _grouped(events) -> dict[tuple[str, str, str], list[float]]:
-    groups: dict[tuple[str, str, str], list[float]] = defaultdict(list)
-    for t, *key in events:
-        groups[tuple(key)].append(t)
-    return groups
-
-
-# The assertions of tests/scenes/test_press_feed_regime_aware.py, under the single pass.
-@pytest.mark.slow
-def test_press_feed_run1_switches_are_located(press):
-    r = press("press_feed_run1.toml")
-    ref = r.reference
-    assert r.status == "completed", r.message
-    run_events, ref_events = _grouped(r.events), _grouped(ref.events)
-    assert sorted(run_events) == sorted(ref_events)
-    assert {k: len(v) for k, v in run_events.items()} == {k: len(v) for k, v in ref_events.items()}
-    assert r.accuracy["event_time_error"] < 1e-4
-    assert r.stats.events >= len(ref.events)
-
-
-@pytest.mark.slow
-def test_press_feed_run1_against_the_reference(press):
-    r = press("press_feed_run1.toml")
-    acc = r.accuracy
-    assert acc["headline_error.feed_length_mean"] < 2e-4
-    assert acc["headline_error.mean_windup_feed"] < 1e-3
-    assert acc["headline_error.peak_windup"] < 1e-3
-    assert acc["trajectory_error"] < 5e-3
-    assert r.value("energy_residual") < 1e-3
-
-
-@pytest.mark.slow
-def test_press_feed_run1_four_regimes_in_every_cycle(press):
-    r = press("press_feed_run1.toml")
-    for seq in run_regime_sequences(r.scene, r.header, r.data):
-        assert set(seq) == {WINDUP, FEED, UNWIND, OVERRUN}, seq
-        assert seq[-1] == OVERRUN
-
-
-@pytest.mark.slow
-def test_press_feed_run2_finds_the_grazing_disengagements(press):
-    r = press("press_feed_run2.toml")
-    ref = r.reference
-    assert r.status == "completed", r.message
-    assert ref.headline["disengagements"] == 2.0
-    assert r.value("disengagements") == ref.headline["disengagements"]
-    run_events, ref_events = _grouped(r.events), _grouped(ref.events)
-    assert {k: len(v) for k, v in run_events.items()} == {k: len(v) for k, v in ref_events.items()}
-    for key, ref_times in ref_events.items():
-        errors = [abs(a - b) for a, b in zip(run_events[key], ref_times, strict=True)]
-        if key == ("clutch", "engaged", "overrun"):
-            assert max(errors) < 1e-3, errors
-            assert min(errors) < 1e-4, errors
-        else:
-            assert max(errors) < 1e-4, (key, errors)
-
-
-@pytest.mark.slow
-def test_press_feed_run2_feed_still_ends_in_the_thesis_regimes(press):
-    r = press("press_feed_run2.toml")
-    ref = r.reference
-    assert r.accuracy["headline_error.feed_length_mean"] < 1e-3
-    k_sp = feed_scene(r.scene).p_clutch["k"]
-    t_b = feed_scene(r.scene).p_load["brake_torque"]
-    assert r.value("mean_windup_feed") < (t_b / k_sp) ** (2.0 / 3.0)
-    assert math.isclose(r.value("mean_windup_feed"), ref.headline["mean_windup_feed"], rel_tol=3e-3)
-    seqs = run_regime_sequences(r.scene, r.header, r.data)
-    assert any(seq.count(FEED) > 1 for seq in seqs), seqs
-
-
-@pytest.mark.slow
-def test_press_feed_run3_against_its_reference(press):
-    # Run 3 has no regime-aware test of its own: the bounds of Run 1's.
-    r = press("press_feed_run3.toml")
-    assert r.status == "completed", r.message
-    acc = r.accuracy
-    assert acc["trajectory_error"] < 5e-3
-    assert acc["event_time_error"] < 1e-4
-    assert r.value("energy_residual") < 1e-3
+        assert stats.landing_do_steps_max <= 8
+        assert stats.landing_do_steps <= 2.5 * stats.landings
 
 
 @pytest.mark.parametrize(

@@ -7,7 +7,7 @@ fuze report of about 1980 (Task 2).
 from components.clock_train_design import BODY_NAMES
 from components.sanda2v_deck import BY_NAME, SHARED
 from orchestrator.scenes.family import SceneFamily, SharedParameter
-from orchestrator.scenes.m739 import escapement_needs, escapement_shared
+from orchestrator.scenes.m739 import TURNS, escapement_needs, escapement_shared
 
 
 def deck_shared() -> tuple[SharedParameter, ...]:
@@ -29,4 +29,6 @@ FAMILY = SceneFamily(
     analysis="orchestrator.scenes.clock_train.report:analyse",
     plot="orchestrator.scenes.clock_train.report:plot",
     reference="orchestrator.scenes.clock_train.report:reference",
+    monolithic="orchestrator.scenes.clock_train.report:monolithic_model",
+    headline=TURNS,
 )

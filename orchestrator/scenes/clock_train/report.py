@@ -20,6 +20,8 @@ Instance names come from ``[report.options]`` (defaults "train" and "verge").
 
 from __future__ import annotations
 
+import math
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -29,10 +31,10 @@ from components.verge_escapement import (
     FREE,
 )
 from orchestrator.plotting import recorded
-from orchestrator.scenario import Scene
+from orchestrator.scene_model import Scene
 from orchestrator.scenes.clock_train.design import train_values, verge_data
 from orchestrator.scenes.clock_train.monolithic import ARMING_ROTOR_ANGLE, run_clock_train
-from orchestrator.scenes.family import Quantity, Reference, quantity
+from orchestrator.scenes.family import Outcome, Quantity, Reference, quantity
 from orchestrator.scenes.m739.report import (
     _parameter,
     _why_not_armed,
@@ -140,3 +142,15 @@ def plot(scene: Scene, header: list[str], data: np.ndarray, path: Path) -> None:
         crossing_time(t, data[:, header.index(signal)], level, rising) if signal in header else None
     )
     escapement_plot(scene, header, data, path, title, t_arm, extra=clock_panels)
+
+
+def monolithic_model(scene: Scene) -> Callable[[float], Outcome]:
+    """The monolithic model with the scene's physics (as the reference runs it), as a
+    function of its tolerance: its turns to arm (NaN: it did not arm)."""
+    kwargs = monolithic_arguments(scene)
+
+    def run(tolerance: float) -> Outcome:
+        result = run_clock_train(tolerance=tolerance, **kwargs)
+        return Outcome(result.turns if result.armed else math.nan, result.reason)
+
+    return run

@@ -11,7 +11,7 @@ from typing import Any
 from components.detached_lever_data import TABLE_I
 from components.detached_lever_design import SEGMENTS
 from orchestrator.errors import ScenarioError
-from orchestrator.scenario import Scene
+from orchestrator.scene_model import Scene
 from orchestrator.units import to_si
 
 LEVER_FMU = "DetachedLever"

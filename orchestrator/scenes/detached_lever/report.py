@@ -56,7 +56,7 @@ from orchestrator.plotting import (
     unit_label,
     window,
 )
-from orchestrator.scenario import Scene
+from orchestrator.scene_model import Scene
 from orchestrator.scenes.detached_lever.lever import LeverScene, lever_scene
 from orchestrator.scenes.detached_lever.monolithic import beat_run
 from orchestrator.scenes.family import Quantity, Reference, quantity

@@ -19,7 +19,7 @@ import numpy as np
 
 from components.gear_mesh import ClockModel, ClockTableModel, InvoluteModel, MeshModel
 from components.mesh_efficiency import train_mesh_contact
-from orchestrator.scenario import Scene
+from orchestrator.scene_model import Scene
 from orchestrator.scenes.gear_mesh.report import mesh_scene
 
 MM = 1e3  # drawing units per metre

@@ -66,7 +66,7 @@ from orchestrator.plotting import (
     run_events,
     save_figure,
 )
-from orchestrator.scenario import Scene
+from orchestrator.scene_model import Scene
 from orchestrator.scenes.family import Quantity, Reference, quantity
 
 #: Names of the efficiency on the (left, right) side of each kind of contact change.

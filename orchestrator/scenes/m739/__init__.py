@@ -2,7 +2,17 @@
 Tepper 1982, *Computer Simulation of Artillery S&A Mechanism*)."""
 
 from components.sanda2v_deck import DECK, SHARED
-from orchestrator.scenes.family import Needs, Option, Role, SceneFamily, SharedParameter
+from orchestrator.scenes.family import (
+    Headline,
+    Needs,
+    Option,
+    Role,
+    SceneFamily,
+    SharedParameter,
+)
+
+#: What an S&A is judged by: the projectile turns until the rotor arms.
+TURNS = Headline("turns_to_arm", "turns_error", "turns")
 
 _ESCAPEMENT_FORCES = ("phi", "phi_dot", "regime", "F12", "F23", "FF12", "FF23")
 _VERGE = ("regime", "PN", "impact_count")
@@ -49,4 +59,6 @@ FAMILY = SceneFamily(
     analysis="orchestrator.scenes.m739.report:analyse",
     plot="orchestrator.scenes.m739.report:plot",
     reference="orchestrator.scenes.m739.report:reference",
+    monolithic="orchestrator.scenes.m739.report:monolithic_model",
+    headline=TURNS,
 )

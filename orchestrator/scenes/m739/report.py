@@ -11,6 +11,7 @@ angle (``scene.stop_when``).  Instance names come from ``[report.options]`` (def
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -34,8 +35,8 @@ from orchestrator.plotting import (
     unit_label,
     window,
 )
-from orchestrator.scenario import Scene
-from orchestrator.scenes.family import Quantity, Reference, quantity
+from orchestrator.scene_model import Scene
+from orchestrator.scenes.family import Outcome, Quantity, Reference, quantity
 from orchestrator.scenes.m739.design import instances, parameter, scene_design
 from orchestrator.scenes.m739.monolithic import run_m739
 
@@ -198,7 +199,10 @@ def reference_from(
             for te, a, b in getattr(result, "train_log", ())
         ]
     events.sort(key=lambda e: e[0])
-    return Reference(headline=headline, signals=signals, events=events, t_range=t_range)
+    # The monolithic model ends at arming, as a scene does on its stop_when.
+    return Reference(
+        headline=headline, signals=signals, events=events, t_range=t_range, at_stop_when=True
+    )
 
 
 def plot(scene: Scene, header: list[str], data: np.ndarray, path: Path) -> None:
@@ -416,3 +420,15 @@ def _overview(
         ax.axvspan(1e3 * t[0], 1e3 * detail_end, color="0.9", zorder=0)
         ax.grid(True, alpha=0.3)
     axes[0].text(1e3 * detail_end, 0.0, " detail below", fontsize=8, va="bottom", color="0.4")
+
+
+def monolithic_model(scene: Scene) -> Callable[[float], Outcome]:
+    """The monolithic model with the scene's physics (as the reference runs it), as a
+    function of its tolerance: its turns to arm (NaN: it did not arm)."""
+    kwargs = monolithic_arguments(scene)
+
+    def run(tolerance: float) -> Outcome:
+        result = run_m739(tolerance=tolerance, **kwargs)
+        return Outcome(result.turns if result.armed else math.nan, result.reason)
+
+    return run

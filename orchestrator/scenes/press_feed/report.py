@@ -55,7 +55,7 @@ from orchestrator.plotting import (
     save_figure,
     unit_label,
 )
-from orchestrator.scenario import Scene
+from orchestrator.scene_model import Scene
 from orchestrator.scenes.family import Quantity, Reference, quantity
 from orchestrator.scenes.press_feed.monolithic import (
     FeedOptions,

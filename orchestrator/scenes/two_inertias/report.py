@@ -12,8 +12,9 @@ import numpy as np
 
 from components.rotational import damped_oscillator_transition
 from orchestrator.plotting import column_unit, pyplot, recorded, save_figure, unit_label
-from orchestrator.scenario import Scene
+from orchestrator.scene_model import Scene
 from orchestrator.scenes.family import Reference
+from orchestrator.stop_condition import reference_crossing
 
 
 def two_inertias_exact(
@@ -77,8 +78,19 @@ def two_inertias_reference(scene: Scene) -> Reference:
             f"{b}.w": x["w_b"],
         }
 
-    final = signals(np.array([scene.stop]))
-    return Reference(headline={"final_angle_a": float(final[f"{a}.phi"][0])}, signals=signals)
+    # A run that stops on scene.stop_when ends where the closed form meets it: the final
+    # angle there (the run's own end: its crossing, within its last step).
+    end, at_condition = scene.stop, False
+    if scene.stop_when is not None:
+        crossing = reference_crossing(signals, scene.stop_when, scene.start, scene.stop)
+        if crossing is not None:
+            end, at_condition = crossing, True
+    final = signals(np.array([end]))
+    return Reference(
+        headline={"final_angle_a": float(final[f"{a}.phi"][0])},
+        signals=signals,
+        at_stop_when=at_condition,
+    )
 
 
 def plot(scene: Scene, header: list[str], data: np.ndarray, path: Path) -> None:

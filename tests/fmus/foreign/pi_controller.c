@@ -10,7 +10,10 @@
  *
  * Build macros: PI_CONTROLLER_GUID, the string the instantiation token must equal;
  * PI_CONTROLLER_FORGETS_INTEGRATOR, fmi2SetFMUstate restores everything but the integrator x
- * (a faulty state restore: a rolled-back step keeps its integral).
+ * (a faulty state restore: a rolled-back step keeps its integral); with
+ * PI_CONTROLLER_FORGETS_AFTER_JUMP as well, it does so only once the set point has left the
+ * value it had at the first step (a fault that shows only after a set-point jump, as a
+ * limiter flag restored wrongly does).
  */
 
 #include <stdarg.h>
@@ -37,6 +40,9 @@ typedef struct {
     ModelState s;
     fmi2CallbackFunctions cb;
     char *instance_name;
+    /* Not part of the state: the set point at the first step, and whether it has left it. */
+    fmi2Real first_set_point;
+    int stepped, jumped;
 } Instance;
 
 static void log_error(Instance *inst, const char *fmt, ...) {
@@ -93,6 +99,9 @@ fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2String guid,
     inst->s.r[VR_UM] = 0.0;
     inst->s.r[VR_X] = 0.0;
     inst->s.time = 0.0;
+    inst->first_set_point = 0.0;
+    inst->stepped = 0;
+    inst->jumped = 0;
     inst->s.mode = MODE_INSTANTIATED;
     update_output(inst);
     return inst;
@@ -213,6 +222,12 @@ fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate state) {
     Instance *inst = (Instance *)c;
     if (inst == NULL || state == NULL) return fmi2Error;
 #ifdef PI_CONTROLLER_FORGETS_INTEGRATOR
+#ifdef PI_CONTROLLER_FORGETS_AFTER_JUMP
+    if (!inst->jumped) {
+        inst->s = *(ModelState *)state;
+        return fmi2OK;
+    }
+#endif
     {
         /* The fault of a tool's export: the integrator is not part of what is restored,
            so a restored controller keeps the integral it had reached. */
@@ -274,6 +289,12 @@ fmi2Status fmi2DoStep(fmi2Component c, fmi2Real t, fmi2Real h, fmi2Boolean noSet
         return fmi2Error;
     }
     r = inst->s.r;
+    if (!inst->stepped) {
+        inst->first_set_point = r[VR_US];
+        inst->stepped = 1;
+    } else if (r[VR_US] != inst->first_set_point) {
+        inst->jumped = 1;
+    }
     r[VR_X] += (r[VR_US] - r[VR_UM]) * h;
     inst->s.time = t + h;
     update_output(inst);

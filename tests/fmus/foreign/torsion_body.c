@@ -30,8 +30,11 @@
  *                           logs 2000 lines, then one of 100000 characters, and returns
  *                           fmi2Error), FAULT_BY_N_SUB (n_sub 101, 102, 103 choose
  *                           FAULT_SEGFAULT, FAULT_HANG, FAULT_STOP; any other runs as built
- *                           without a fault); and FAULT_TERMINATE_SEGFAULT (fmi2Terminate
- *                           writes through a null pointer)
+ *                           without a fault); FAULT_TERMINATE_SEGFAULT (fmi2Terminate
+ *                           writes through a null pointer); and FAULT_TERMINATE_AFTER (doStep
+ *                           completes the step, then returns fmi2Discard with fmi2Terminated
+ *                           true: fmi2LastSuccessfulTime is the step's end, as the Reference
+ *                           FMU Stair ends on its last event)
  *   TORSION_BODY_INPUT_DERIVATIVES  if defined, fmi2SetRealInputDerivatives takes the first
  *                           derivative of flange.w (canInterpolateInputs="true"): over the
  *                           next steps the flange moves at w_in + a*s (a the derivative, until
@@ -99,6 +102,7 @@ typedef struct {
 #define FAULT_LONG_ERROR 12
 #define FAULT_BY_N_SUB 13
 #define FAULT_TERMINATE_SEGFAULT 14
+#define FAULT_TERMINATE_AFTER 15
 #ifndef TORSION_BODY_FAULT_TIME
 #define TORSION_BODY_FAULT_TIME 0.0
 #endif
@@ -740,6 +744,14 @@ fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint,
     r[VR_W] = r[VR_W_IN] + v;
     inst->s.time = currentCommunicationPoint + h;
     update_outputs(inst);
+#if defined(TORSION_BODY_FAULT) && TORSION_BODY_FAULT == FAULT_TERMINATE_AFTER
+    if (currentCommunicationPoint >= TORSION_BODY_FAULT_TIME - 1e-12) {
+        inst->s.terminated = fmi2True;
+        log_message(inst, fmi2Discard, "logStatusDiscard", "end stop reached at t = %g s",
+                    inst->s.time);
+        return fmi2Discard;
+    }
+#endif
     return status;
 }
 
