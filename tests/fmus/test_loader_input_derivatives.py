@@ -196,3 +196,22 @@ def test_the_press_feed_through_the_standard_call(tmp_path, monkeypatch) -> None
     scale = np.abs(held.signal("load.feed_length")).max()
     end = abs(ramped.signal("load.feed_length")[-1] - held.signal("load.feed_length")[-1])
     assert end < 1e-10 * scale
+
+
+def test_an_fmu_that_does_not_interpolate_refuses_derivatives(capfd) -> None:
+    fmu = build_fmu("Inertia")
+    md = read_model_description(fmu)
+    tau = next(v.valueReference for v in md.modelVariables if v.name == "tau")
+    slave = FMU2Slave(
+        guid=md.guid,
+        unzipDirectory=extract(fmu),
+        modelIdentifier=md.coSimulation.modelIdentifier,
+        instanceName="inertia",
+    )
+    slave.instantiate()
+    with pytest.raises(FMICallException):
+        slave.setRealInputDerivatives([tau], [1], [1.0])
+    slave.freeInstance()
+    out = capfd.readouterr()
+    said = "this FMU does not interpolate its inputs (canInterpolateInputs is false)"
+    assert said in out.out + out.err
