@@ -9,8 +9,10 @@ code imports are written to ``resources/requirements.txt`` (pythonfmu's deploy c
 installs them), and ``documentation/index.html`` tells a user of another tool how to use
 the FMU.  ``fmus.description`` completes the model description.  On Linux the FMU's binary
 is a small loader (``fmus.host_loader``) that starts Python where the host has none and
-forwards to pythonfmu's runtime, so the FMU loads in C and C++ hosts too.  The archive's
-entries carry a fixed date: the same sources and build environment give the same file.
+forwards to pythonfmu's runtime, so the FMU loads in C and C++ hosts too; it also serves
+FMI 2.0 input derivatives where the component takes an input's rate
+(``fmus.input_derivatives``).  The archive's entries carry a fixed date: the same sources
+and build environment give the same file.
 """
 
 from __future__ import annotations
@@ -34,6 +36,7 @@ from components.base import Component
 from fmus.description import complete_description
 from fmus.documentation import render_documentation
 from fmus.host_loader import LOADER_SOURCE, loader_binary, loader_plan, pack_loader
+from fmus.input_derivatives import declare_input_derivatives
 from fmus.kernel_build import (
     KERNEL_SOURCES,
     compiled_kernel,
@@ -56,6 +59,7 @@ BUILD_CODE = (
     FMUS_DIR / "units.py",
     FMUS_DIR / "host_loader.py",
     FMUS_DIR / "kernel_build.py",
+    FMUS_DIR / "input_derivatives.py",
     LOADER_SOURCE,
 )
 #: the date of every entry of an FMU archive (the earliest a zip file can hold)
@@ -188,6 +192,8 @@ def _finish(
         element.text = element.text.strip() if element.text else None
         element.tail = None
     complete_description(root, component_class)
+    if loader is not None:  # it serves input derivatives (pythonfmu's runtime does not)
+        declare_input_derivatives(root, members, component_class)
     xml = parseString(ET.tostring(root, "UTF-8")).toprettyxml(indent="  ", encoding="UTF-8")
     members["modelDescription.xml"] = xml
     if loader is not None:

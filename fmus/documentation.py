@@ -21,6 +21,7 @@ from html import escape
 from components.base import COMMON_OUTPUTS, Component
 from fmus.description import EVENT_TIME, INDICATOR_PREFIX, REGIME
 from fmus.host_loader import RUNTIME_FILE, loader_binary, newest_version_needed, runtime_binary
+from fmus.input_derivatives import ramped_inputs
 from fmus.ports import PORT_RULE
 from fmus.registry import FmuRecord
 
@@ -48,7 +49,7 @@ def render_documentation(record: FmuRecord, loader: bool = True) -> str:
         ("coupling", "How to couple it", _coupling_section(record)),
         ("host", "Host requirements", _host_section(record, loader)),
         ("tools", "Usage in other tools", _tools_section(record)),
-        ("capabilities", "FMI capabilities", _capabilities_section()),
+        ("capabilities", "FMI capabilities", _capabilities_section(record, loader)),
     ]
     toc = "".join(f'<li><a href="#{key}">{escape(head)}</a></li>' for key, head, _ in sections)
     body = "".join(
@@ -470,12 +471,27 @@ def _tools_section(record: FmuRecord) -> str:
     )
 
 
-def _capabilities_section() -> str:
+def _input_derivatives(record: FmuRecord, loader: bool) -> str:
+    """What the FMU does with its inputs over a step (fmus.input_derivatives)."""
+    pairs = ramped_inputs(record.component_class) if loader else []
+    if not pairs:
+        return "inputs are held constant over a step (no input derivatives or interpolation)"
+    names = ", ".join(
+        f"<code>{escape(u)}</code> (what the input <code>{escape(r)}</code> also sets)"
+        for u, r in pairs
+    )
+    return (
+        "<strong>canInterpolateInputs</strong>: fmi2SetRealInputDerivatives takes the first "
+        f"derivative of {names}; the input then ramps from its value set at the step start, "
+        "until the derivative is set again"
+    )
+
+
+def _capabilities_section(record: FmuRecord, loader: bool) -> str:
     return (
         "<ul>\n"
         "<li>FMI 2.0 <strong>co-simulation</strong> only (no model exchange); variable "
-        "communication step sizes; inputs are held constant over a step (no input "
-        "derivatives or interpolation).</li>\n"
+        f"communication step sizes; {_input_derivatives(record, loader)}.</li>\n"
         "<li><strong>canGetAndSetFMUstate</strong>: fmi2GetFMUstate saves the complete state, "
         "hidden variables and the regime included, so restoring it and stepping again "
         "reproduces the same numbers bit for bit; a state can be restored any number of "

@@ -6,7 +6,11 @@ before it relies on a capability: ``lacking`` lists the FMUs of a system without
 capability.  The regime-aware master rejects and retakes steps (``canGetAndSetFMUstate``)
 of varying size (``canHandleVariableCommunicationStepSize``); a fixed-step master varies
 its step only where its last one is shortened to land on the stop time or where it lands
-on an input signal's breakpoint.
+on an input signal's breakpoint.  A master that ramps a held input through a step passes
+its slope by FMI 2.0's standard call (``canInterpolateInputs``,
+fmi2SetRealInputDerivatives) where the FMU declares it and has no input with the role
+rate_of that input (``takes_input_derivative``); our own FMUs keep their rate_of input,
+whose arithmetic the example runs were validated with.
 """
 
 from __future__ import annotations
@@ -61,6 +65,22 @@ def lacking(system: Any, capabilities: Iterable[str]) -> list[Shortfall]:
         for c in wanted
         if not has(model, c)
     ]
+
+
+def takes_input_derivative(model: Any, name: str) -> bool:
+    """Whether a master passes the slope of FMU input ``name`` (a continuous Real input
+    it does not sample) through fmi2SetRealInputDerivatives: the FMU declares
+    canInterpolateInputs and takes no rate of the input through an input with the role
+    rate_of it."""
+    var = model.variables.get(name)
+    return (
+        has(model, INTERPOLATE_INPUTS)
+        and var is not None
+        and var.causality == "input"
+        and (var.type, var.variability) == ("Real", "continuous")
+        and name not in model.sampled
+        and model.with_role("rate_of", name) is None
+    )
 
 
 def require(system: Any, capabilities: Iterable[str], why: str) -> None:

@@ -373,6 +373,25 @@ class FmuInstance:
 
         return set_values
 
+    def derivative_setter(self, refs: list[int]) -> Callable[[list[float]], None]:
+        """A function that sets the first time derivatives of the Real inputs ``refs``
+        (fmi2SetRealInputDerivatives, order 1): over the next step the FMU ramps each input
+        from its value set, u(t) = u + du (t - t_step_start)."""
+        n = len(refs)
+        call = self._function("fmi2SetRealInputDerivatives")
+        vr, order, buf = (
+            (fmi2ValueReference * n)(*refs),
+            (fmi2Integer * n)(*[1] * n),
+            (fmi2Real * n)(),
+        )
+        component = self.fmu.component
+
+        def set_derivatives(values: list[float]) -> None:
+            buf[:] = values
+            call(component, vr, n, order, buf)
+
+        return set_derivatives
+
     def get(self, name: str) -> float:
         ref = self.refs([name])
         return (self.fmu.getInteger(ref) if self.is_integer(name) else self.fmu.getReal(ref))[0]

@@ -23,6 +23,23 @@
  * (the runtime has released its Python objects and would crash): further calls return
  * fmi2Error and fmi2FreeInstance frees only what the loader holds.
  *
+ * Input derivatives (FMI 2.0 fmi2SetRealInputDerivatives, which pythonfmu's runtime does not
+ * serve) are the loader's: where the build wrote resources/input_derivatives.txt (the
+ * value references of each input the component ramps and of its input with the role
+ * rate_of it; the model description then says canInterpolateInputs="true"), a first
+ * derivative du of input u set by the host means u(t) = u + du (t - tc) over the next step
+ * (tc: its start, u: the input's value there).  The component ramps its input about the
+ * step's middle, u_mid + rate (t - tc - h/2), so the loader sets u to u + du h/2 and the
+ * rate input to du, steps, and then sets the input to where its ramp ends, u + du h (to u
+ * where the step was not taken), and the rate input back: after the step fmi2GetReal of
+ * the input gives its value at the step end, and the outputs that depend on it directly
+ * are computed with that value.  The derivative stays in force, the ramp going on from
+ * there, until it is set again or the instance is reset; a value set by fmi2SetReal starts
+ * the next ramp.  A derivative overrides the rate input for its input.  An FMU state
+ * holds the derivatives set.  A derivative of the rate input itself, or of order 2
+ * or more, is accepted and not used (the component ramps to first order); of any other
+ * variable, or of order 0, it is refused with fmi2Error.
+ *
  * Compiled at build time against the headers of the Python that builds the FMU (PyConfig's
  * layout is that version's), without linking libpython: every Python function is looked up
  * at run time.
@@ -34,6 +51,7 @@
 #include <dlfcn.h>
 #include <limits.h>
 #include <link.h>
+#include <math.h>
 #include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -43,6 +61,8 @@
 #define EXPORT __attribute__((visibility("default")))
 #define RUNTIME_FILE "libpythonfmu-export.so"
 #define PYTHON_FILE "python.txt"
+#define RAMPS_FILE "input_derivatives.txt"
+#define MAX_RAMPS 16
 #define PYTHON_VARIABLE "MECHCOSIM_PYTHON"
 #define WHY_SIZE 2048
 
@@ -90,6 +110,10 @@ typedef struct {
     int failed;         /* the runtime answered fmi2Fatal: do not call it again */
     int phase;          /* where the instance is in FMI 2.0's state machine (Phase) */
     int refused;        /* the runtime logged an fmi2Error message during the current call */
+    size_t n_ramps;     /* the inputs the component ramps (RAMPS_FILE) */
+    fmi2ValueReference ramped[MAX_RAMPS]; /* each input */
+    fmi2ValueReference rate[MAX_RAMPS];   /* its input with the role rate_of it */
+    fmi2Real slope[MAX_RAMPS];            /* the derivative the host set; NaN: none */
 } Instance;
 
 /* FMI 2.0's co-simulation states (4.2.4, figure "Calling sequence of Co-Simulation C
@@ -158,10 +182,6 @@ static const char* const PHASE_NAMES[N_PHASES] = {
        const fmi2ValueReference known[], size_t n_known, const fmi2Real dv_known[],             \
        fmi2Real dv_unknown[]),                                                                  \
       (i->inner, unknown, n_unknown, known, n_known, dv_known, dv_unknown))                     \
-    X(fmi2SetRealInputDerivatives, SETTABLE,                                                    \
-      (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Integer order[],   \
-       const fmi2Real v[]),                                                                     \
-      (i->inner, vr, nvr, order, v))                                                            \
     X(fmi2GetRealOutputDerivatives, AFTER_STEPS | IN(ERROR_STATE),                             \
       (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Integer order[],   \
        fmi2Real v[]),                                                                           \
@@ -202,6 +222,10 @@ static const char* const PHASE_NAMES[N_PHASES] = {
     X(fmi2DeSerializeFMUstate, ANY_BUT_FATAL,                                                   \
       (fmi2Component c, const fmi2Byte bytes[], size_t size, fmi2FMUstate * state),             \
       (i->inner, bytes, size, state))                                                           \
+    X(fmi2SetRealInputDerivatives, SETTABLE,                                                    \
+      (fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Integer order[],   \
+       const fmi2Real v[]),                                                                     \
+      (i->inner, vr, nvr, order, v))                                                            \
     X(fmi2DoStep, IN(STEP_COMPLETE),                                                            \
       (fmi2Component c, fmi2Real currentCommunicationPoint, fmi2Real communicationStepSize,     \
        fmi2Boolean noSetFMUStatePriorToCurrentCommunicationPoint),                              \
@@ -702,6 +726,32 @@ static void own_guid(char* guid, size_t size) {
     guid[end - at] = '\0';
 }
 
+/* The inputs this FMU ramps, from resources/input_derivatives.txt beside its binary: lines
+ * "<value reference of the input> <value reference of its rate input>"; none without it. */
+static void read_ramps(Instance* i) {
+    char binaries[PATH_MAX], why[WHY_SIZE];
+    i->n_ramps = 0;
+    if (!own_directory(binaries, sizeof binaries, why)) return;
+    char path[PATH_MAX + 64];
+    snprintf(path, sizeof path, "%s/../../resources/%s", binaries, RAMPS_FILE);
+    FILE* f = fopen(path, "r");
+    if (f == NULL) return;
+    char line[256];
+    unsigned input, rate;
+    while (fgets(line, sizeof line, f) && i->n_ramps < MAX_RAMPS) {
+        if (line[0] == '#' || sscanf(line, "%u %u", &input, &rate) != 2) continue;
+        i->ramped[i->n_ramps] = input;
+        i->rate[i->n_ramps] = rate;
+        i->slope[i->n_ramps] = NAN;
+        i->n_ramps++;
+    }
+    fclose(f);
+}
+
+static void forget_slopes(Instance* i) {
+    for (size_t k = 0; k < i->n_ramps; ++k) i->slope[k] = NAN;
+}
+
 static int instantiable(fmi2Type type, fmi2String guid, char* why) {
     if (type != fmi2CoSimulation) {
         snprintf(why, WHY_SIZE, "fmi2Instantiate: this FMU is for co-simulation only "
@@ -762,6 +812,7 @@ EXPORT fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, 
     i->relayed.logger = relay;
     i->relayed.componentEnvironment = i;
     i->debug = loggingOn;
+    read_ramps(i);
     /* The runtime cannot do without the resource location: where a host gives none, the
      * FMU's own resources/ beside binaries/ is meant. */
     char resources[PATH_MAX + 32];
@@ -880,16 +931,117 @@ OWN_FUNCTIONS(ALLOWED)
 MOVE(fmi2EnterInitializationMode, INITIALIZATION_MODE)
 MOVE(fmi2ExitInitializationMode, STEP_COMPLETE)
 MOVE(fmi2Terminate, TERMINATED)
-MOVE(fmi2Reset, INSTANTIATED)
+
+EXPORT fmi2Status fmi2Reset(fmi2Component c) {
+    Instance* i = c;
+    if (!admit(i, "fmi2Reset", ALLOWED_fmi2Reset)) return fmi2Error;
+    fmi2Status status = settle(i, runtime.fmi2Reset(i->inner));
+    if (status == fmi2OK) {
+        i->phase = INSTANTIATED;
+        forget_slopes(i);
+    }
+    return status;
+}
+
+/* -- input derivatives ----------------------------------------------------------------------- */
+/* Where u is among the inputs the FMU ramps (its index), -1 where it is a rate input (whose
+ * derivative is not used), -2 where it is neither. */
+static long ramp_of(const Instance* i, fmi2ValueReference vr) {
+    for (size_t k = 0; k < i->n_ramps; ++k) {
+        if (i->ramped[k] == vr) return (long)k;
+        if (i->rate[k] == vr) return -1;
+    }
+    return -2;
+}
+
+EXPORT fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference vr[],
+                                              size_t nvr, const fmi2Integer order[],
+                                              const fmi2Real v[]) {
+    Instance* i = c;
+    if (!admit(i, "fmi2SetRealInputDerivatives", ALLOWED_fmi2SetRealInputDerivatives))
+        return fmi2Error;
+    char why[512];
+    for (size_t n = 0; n < nvr; ++n) { /* all checked first: a refused call changes nothing */
+        long k = ramp_of(i, vr[n]);
+        if (i->n_ramps == 0)
+            snprintf(why, sizeof why, "fmi2SetRealInputDerivatives: this FMU does not "
+                     "interpolate its inputs (canInterpolateInputs is false)");
+        else if (k == -2)
+            snprintf(why, sizeof why, "fmi2SetRealInputDerivatives: value reference %u is no "
+                     "input this FMU ramps through a step", (unsigned)vr[n]);
+        else if (order[n] < 1)
+            snprintf(why, sizeof why, "fmi2SetRealInputDerivatives: order %d of value "
+                     "reference %u; the order of a derivative is 1 or more", (int)order[n],
+                     (unsigned)vr[n]);
+        else if (!isfinite(v[n]))
+            snprintf(why, sizeof why, "fmi2SetRealInputDerivatives: the derivative of value "
+                     "reference %u is not finite", (unsigned)vr[n]);
+        else
+            continue;
+        emit(&i->host, i->name, fmi2Error, "logStatusError", why);
+        return settle(i, fmi2Error);
+    }
+    for (size_t n = 0; n < nvr; ++n) {
+        long k = ramp_of(i, vr[n]);
+        if (k >= 0 && order[n] == 1) i->slope[k] = v[n];
+    }
+    return fmi2OK;
+}
+
+/* Set the inputs of the step's ramps (the value at the step's middle and the rate) into
+ * the runtime, and what they were into `held`; 0 where no derivative is set. */
+static size_t set_ramps(Instance* i, fmi2Real h, fmi2ValueReference vrs[], fmi2Real held[],
+                        fmi2Status* status) {
+    size_t n = 0;
+    for (size_t k = 0; k < i->n_ramps; ++k) {
+        if (isnan(i->slope[k])) continue;
+        vrs[n] = i->ramped[k];
+        vrs[n + 1] = i->rate[k];
+        n += 2;
+    }
+    *status = fmi2OK;
+    if (n == 0) return 0;
+    *status = settle(i, runtime.fmi2GetReal(i->inner, vrs, n, held));
+    if (*status != fmi2OK && *status != fmi2Warning) return 0;
+    fmi2Real ramp[2 * MAX_RAMPS];
+    size_t m = 0;
+    for (size_t k = 0; k < i->n_ramps; ++k) {
+        if (isnan(i->slope[k])) continue;
+        ramp[m] = held[m] + i->slope[k] * (0.5 * h);
+        ramp[m + 1] = i->slope[k];
+        m += 2;
+    }
+    *status = settle(i, runtime.fmi2SetReal(i->inner, vrs, n, ramp));
+    return (*status == fmi2OK || *status == fmi2Warning) ? n : 0;
+}
 
 EXPORT fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint,
                              fmi2Real communicationStepSize,
                              fmi2Boolean noSetFMUStatePriorToCurrentCommunicationPoint) {
     Instance* i = c;
     if (!admit(i, "fmi2DoStep", ALLOWED_fmi2DoStep)) return fmi2Error;
-    fmi2Status status =
-        settle(i, runtime.fmi2DoStep(i->inner, currentCommunicationPoint, communicationStepSize,
-                                     noSetFMUStatePriorToCurrentCommunicationPoint));
+    fmi2ValueReference vrs[2 * MAX_RAMPS];
+    fmi2Real held[2 * MAX_RAMPS];
+    fmi2Status status;
+    size_t ramped = set_ramps(i, communicationStepSize, vrs, held, &status);
+    if (status != fmi2OK && status != fmi2Warning) return status;
+    status = settle(i, runtime.fmi2DoStep(i->inner, currentCommunicationPoint,
+                                          communicationStepSize,
+                                          noSetFMUStatePriorToCurrentCommunicationPoint));
+    if (ramped > 0 && !i->failed) {
+        /* each input where its ramp is at the step end (where the step was not taken:
+         * as set), each rate input as it was */
+        if (status == fmi2OK || status == fmi2Warning) {
+            size_t m = 0;
+            for (size_t k = 0; k < i->n_ramps; ++k) {
+                if (isnan(i->slope[k])) continue;
+                held[m] += i->slope[k] * communicationStepSize;
+                m += 2;
+            }
+        }
+        fmi2Status back = settle(i, runtime.fmi2SetReal(i->inner, vrs, ramped, held));
+        if (back > status) status = back;
+    }
     if (status == fmi2OK) i->phase = STEP_COMPLETE;
     if (status == fmi2Discard) i->phase = STEP_FAILED;
     return status;
@@ -903,6 +1055,7 @@ typedef struct {
     unsigned mark;
     const void* owner; /* this loader's copy: one per FMU binary */
     int phase;
+    fmi2Real slope[MAX_RAMPS]; /* the input derivatives set */
     fmi2FMUstate inner;
 } SavedState;
 
@@ -944,6 +1097,7 @@ EXPORT fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate* state) {
     saved->mark = STATE_MARK;
     saved->owner = (const void*)&runtime;
     saved->phase = i->phase;
+    memcpy(saved->slope, i->slope, sizeof saved->slope);
     *state = saved;
     return status;
 }
@@ -954,7 +1108,10 @@ EXPORT fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate state) {
     SavedState* saved = own_state(i, "fmi2SetFMUstate", state);
     if (saved == NULL) return fmi2Error;
     fmi2Status status = settle(i, runtime.fmi2SetFMUstate(i->inner, saved->inner));
-    if (status == fmi2OK) i->phase = saved->phase;
+    if (status == fmi2OK) {
+        i->phase = saved->phase;
+        memcpy(i->slope, saved->slope, sizeof i->slope);
+    }
     return status;
 }
 
@@ -971,8 +1128,9 @@ EXPORT fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate* state) {
     return status;
 }
 
-/* Serialized: the state-machine state (4 bytes), then the runtime's bytes. */
-#define STATE_HEADER 8
+/* Serialized: a mark and the state-machine state (4 bytes each), the input derivatives,
+ * then the runtime's bytes. */
+#define STATE_HEADER (8 + MAX_RAMPS * sizeof(fmi2Real))
 EXPORT fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate state, size_t* size) {
     Instance* i = c;
     if (!admit(i, "fmi2SerializedFMUstateSize", ALLOWED_fmi2SerializedFMUstateSize))
@@ -994,7 +1152,8 @@ EXPORT fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate state, fmi
     if (saved == NULL) return fmi2Error;
     if (size < STATE_HEADER) return settle(i, fmi2Error);
     unsigned header[2] = {STATE_MARK, (unsigned)saved->phase};
-    memcpy(bytes, header, STATE_HEADER);
+    memcpy(bytes, header, sizeof header);
+    memcpy(bytes + sizeof header, saved->slope, sizeof saved->slope);
     return settle(i, runtime.fmi2SerializeFMUstate(i->inner, saved->inner, bytes + STATE_HEADER,
                                                    size - STATE_HEADER));
 }
@@ -1004,7 +1163,7 @@ EXPORT fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte bytes[
     Instance* i = c;
     if (!admit(i, "fmi2DeSerializeFMUstate", ALLOWED_fmi2DeSerializeFMUstate)) return fmi2Error;
     unsigned header[2] = {0, 0};
-    if (bytes != NULL && size >= STATE_HEADER) memcpy(header, bytes, STATE_HEADER);
+    if (bytes != NULL && size >= STATE_HEADER) memcpy(header, bytes, sizeof header);
     if (state == NULL || header[0] != STATE_MARK || header[1] >= N_PHASES) {
         emit(&i->host, i->name, fmi2Error, "logStatusError",
              "fmi2DeSerializeFMUstate: the bytes given are no FMU state this FMU serialized");
@@ -1022,6 +1181,7 @@ EXPORT fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte bytes[
     saved->mark = STATE_MARK;
     saved->owner = (const void*)&runtime;
     saved->phase = (int)header[1];
+    memcpy(saved->slope, bytes + sizeof header, sizeof saved->slope);
     *state = saved;
     return status;
 }

@@ -5,7 +5,10 @@ A Real input is held over a macro step.  One an FMU samples as a state at the st
 at a value standing for the step (their step mean).  An FMU that does not say which of its
 inputs are sampled (one from another tool) is a black box: averaging a sampled input would
 be wrong at first order, unseen by the error test, so its inputs stay at their step-start
-values and their change over the step is the error (first order).
+values and their change over the step is the error (first order).  Where such an FMU
+declares that it interpolates its inputs (FMI 2.0 ``canInterpolateInputs``), a master that
+ramps them passes their slope from the step start by fmi2SetRealInputDerivatives
+(``interpolated``; orchestrator/capabilities.py says which inputs).
 
 The error measures are relative to each signal's running scale: its largest magnitude so
 far, from its declared FMI ``nominal`` (a speed starting from rest is not held to its first
@@ -14,8 +17,9 @@ millionths).
 
 from __future__ import annotations
 
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
+from orchestrator import capabilities
 from orchestrator.masters.switches import Readings
 from orchestrator.system import CoupledSystem
 
@@ -28,6 +32,17 @@ class HeldInput(NamedTuple):
     source: Slot  # the output that drives it
     averaged: bool  # held at its step mean (else at its step-start value)
     name: str  # the input's name in its FMU
+    #: its FMU ramps it from its step-start value by the slope fmi2SetRealInputDerivatives
+    #: gives (an FMU's own rate_of input is preferred where it has one)
+    interpolated: bool = False
+
+
+class Slopes(NamedTuple):
+    """The inputs of one FMU it ramps by the slopes fmi2SetRealInputDerivatives gives."""
+
+    instance: int
+    indices: list[int]  # of the inputs in its instance's feed order
+    setter: Any  # sets their first derivatives
 
 
 class HeldInputs:
@@ -36,7 +51,7 @@ class HeldInputs:
 
     def __init__(self, system: CoupledSystem) -> None:
         self.system = system
-        held, unannotated = set(), set()
+        held, unannotated, unsloped = set(), set(), set()
         #: per instance, its Real inputs in feed order
         self.inputs: list[list[HeldInput]] = [[] for _ in system.names]
         for c, src in zip(system.connections, system.connection_sources, strict=True):
@@ -50,11 +65,17 @@ class HeldInputs:
             elif not sampled:
                 held.add(src)
             averaged = model.annotated and not sampled
-            self.inputs[j].append(HeldInput(src, averaged, c.target[1]))
+            interpolated = capabilities.takes_input_derivative(model, c.target[1])
+            if not model.annotated and not interpolated:
+                unsloped.add(src)
+            self.inputs[j].append(HeldInput(src, averaged, c.target[1], interpolated))
         #: every held signal (inputs held at the step start: the error is their change)
         self.signals: list[Slot] = sorted(held | unannotated)
         #: the signals into black boxes (held at the step start whatever the scheme)
         self.unannotated: list[Slot] = sorted(unannotated)
+        #: of those, the ones some black box takes with no slope: held through the step even
+        #: by a master that passes slopes
+        self.unsloped: list[Slot] = sorted(unsloped)
         self.scale = {s: system.nominal(*s) for s in self.signals}
         #: every Real connection source (the midpoint hold's corrector compares them)
         self.outputs: list[Slot] = sorted({s for s in system.connection_sources if s is not None})
@@ -76,6 +97,21 @@ class HeldInputs:
                 if held.averaged
             }
         )
+
+    def interpolated_sources(self) -> list[Slot]:
+        """The sources of the inputs FMUs ramp by input derivatives, sorted."""
+        return sorted({h.source for inputs in self.inputs for h in inputs if h.interpolated})
+
+    def slopes(self) -> list[Slopes]:
+        """Per FMU that takes input derivatives, the inputs it ramps by them."""
+        found = []
+        for j, inputs in enumerate(self.inputs):
+            indices = [k for k, held in enumerate(inputs) if held.interpolated]
+            if indices:
+                inst = self.system.instances[j]
+                refs = inst.refs([inputs[k].name for k in indices])
+                found.append(Slopes(j, indices, inst.derivative_setter(refs)))
+        return found
 
     def change_ratio(self, before: Readings, signals: list[Slot], tolerance: float) -> float:
         """Held-input error relative to ``tolerance``: the largest change of the signals

@@ -64,6 +64,11 @@ class InputExtrapolation:
             return start
         return start + c[0] * 0.5 * h + c[1] * (h * h / 3.0 + 0.5 * c[2] * h)
 
+    def slope(self, source: Slot) -> float:
+        """The extrapolated signal's time derivative at the step start (0: held)."""
+        c = self.coefficients.get(source)
+        return 0.0 if c is None else c[0] + c[1] * c[2]
+
     @property
     def second_order(self) -> bool:
         return bool(self.coefficients)

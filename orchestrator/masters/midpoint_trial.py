@@ -17,7 +17,11 @@ Where an FMU takes a held input's rate over the step (a Real input with the role
 it, neither connected nor driven: the press feed's drive and brake take the clutch
 torque's), the corrector also sets that rate, the slope from the start to the predicted
 end value, so the input ramps through the step (first-order hold) rather than sitting at
-its mean: the receiver then takes the first moment of its change too.
+its mean: the receiver then takes the first moment of its change too.  A black box that
+declares it interpolates its inputs (FMI 2.0 ``canInterpolateInputs``, and no rate_of input
+of its own) takes that slope by fmi2SetRealInputDerivatives, its input held at its start
+value and ramped from there (the predictor's slope is 0); its inputs' change then is judged
+by the corrector, not by the first-order change measure.
 
 A predictor that crosses a switch is shortened to it; the step that lands on it is
 corrected with the end values predicted just before the switch (those after it would
@@ -80,14 +84,17 @@ class MidpointTrials:
         self.midpoint = settings.midpoint
         self.held = HeldInputs(system)
         self.ramps = self._ramps() if self.midpoint else []
+        self.slopes = self.held.slopes() if self.midpoint else []
         self._ramps_set: dict[tuple[int, int], tuple[int, float]] = {}
         #: FMU states the predictors of this macro step kept, freed at its end
         self._kept: list[list[Any]] = []
         control = settings.control
         self.restart = RestartSteps(settings.first_step, control.zero_error_restart, True)
-        if self.held.black_boxes and self.midpoint:
+        self.sloped = {j for j, _, _ in self.slopes}
+        held_boxes = [b for b in self.held.black_boxes if system.index[b] not in self.sloped]
+        if held_boxes and self.midpoint:
             stats.warnings.append(
-                f"FMU {', '.join(map(repr, self.held.black_boxes))} declares no sampled "
+                f"FMU {', '.join(map(repr, held_boxes))} declares no sampled "
                 "inputs, event indicators or regimes: its inputs are held at the step start "
                 "(first order in the step, the step sized by their change) and its internal "
                 "switches are found only through the error test"
@@ -169,6 +176,8 @@ class MidpointTrials:
             system.feed(i)
         if self.ramps:
             self._set_ramps({})
+        for _, indices, setter in self.slopes:
+            setter([0.0] * len(indices))
         return _Predictor(t, h, self._step_all(t, h, keep=self.midpoint))
 
     def _step_all(
@@ -208,14 +217,21 @@ class MidpointTrials:
         feeds, retake = [], []
         at_predictor = at is not None and (at.t, at.h) == (t, h) and at.states is not None
         for i, inputs in enumerate(self.held.inputs):
+            # At the step mean where averaged, else at the step-start value (one its FMU
+            # ramps by an input derivative, too: from there).
             reals = [
-                0.5 * (values0[s][k] + predicted[s][k]) if averaged else values0[s][k]
-                for (s, k), averaged, _ in inputs
+                0.5 * (values0[s][k] + predicted[s][k])
+                if averaged and not interpolated
+                else values0[s][k]
+                for (s, k), averaged, _, interpolated in inputs
             ]
             feeds.append(reals)
             # An FMU whose held inputs the correction leaves as they were would retake
             # the predictor's very step: when it is at its end, it stays (a doStep fewer).
-            if not (at_predictor and _same(reals, [values0[s][k] for (s, k), _, _ in inputs])):
+            same = _same(reals, [values0[s][k] for (s, k), *_ in inputs])
+            if same and i in self.sloped:  # and with no slope now
+                same = all(predicted[s][k] == values0[s][k] for (s, k), *_ in inputs)
+            if not (at_predictor and same):
                 retake.append(i)
         # Back to the step start, those that stay to the end of their predictor step.
         kept = at.states if at is not None else None
@@ -230,6 +246,11 @@ class MidpointTrials:
                 s, n = self.held.inputs[j][k].source
                 rates[(j, k)] = (predicted[s][n] - values0[s][n]) / h
             self._set_ramps(rates)
+        for j, indices, setter in self.slopes:
+            if j in system.held_back:  # stepped as Jacobi steps it: held (masters/held_back.py)
+                continue
+            sources = [self.held.inputs[j][k].source for k in indices]
+            setter([(predicted[s][n] - values0[s][n]) / h for s, n in sources])
         self._step_all(t, h, retake)
         worst, tol = 0.0, self.settings.tolerance
         values = system.values
@@ -279,9 +300,8 @@ class MidpointTrials:
         held, tol = self.held, self.settings.tolerance
         if not self.midpoint:
             return Estimate(held.change_ratio(start.before, held.signals, tol), True)
-        unannotated = (
-            held.change_ratio(start.before, held.unannotated, tol) if held.unannotated else 0.0
-        )
+        # the black-box signals held through the step (not ramped by a slope)
+        unannotated = held.change_ratio(start.before, held.unsloped, tol) if held.unsloped else 0.0
         return Estimate(max(correction.ratio, unannotated), unannotated > correction.ratio)
 
     # -- ramped inputs -----------------------------------------------------------------

@@ -6,7 +6,10 @@ exceeds the tolerance.
 Inputs.  A held input is set to the mean over the step of its source's linear
 extrapolation from the last exchange point of the same regime (after a regime switch the
 first step holds the start values; over an FMU's internal event the slopes go on:
-masters/input_extrapolation.py).  A source stepped earlier in the same pass that gives its
+masters/input_extrapolation.py).  A black box that declares it interpolates its inputs
+(FMI 2.0 ``canInterpolateInputs``) takes them at their start values with the
+extrapolation's slope there, by fmi2SetRealInputDerivatives, and is judged as the held
+signals are.  A source stepped earlier in the same pass that gives its
 step mean (an output with the role step_mean_of the connected one: the verge's escapement
 torque whose impulse its wheel took) gives that instead, so its receiver takes the very
 impulse of the step; so does its rate over the step (``T_esc_rate_mean``, from the
@@ -82,8 +85,10 @@ class SinglePassTrials:
         self.restart = RestartSteps(settings.first_step, control.restart, False)
         self.held = HeldInputs(system)
         # Every averaged signal is extrapolated (for the feeds); not every one is judged.
+        sloped = self.held.interpolated_sources()
+        self.slopes = {j: (indices, setter) for j, indices, setter in self.held.slopes()}
         self.extrapolation = InputExtrapolation(
-            self.held.averaged_sources(), control.extrapolation_points
+            sorted({*self.held.averaged_sources(), *sloped}), control.extrapolation_points
         )
         # FMUs that end a step at their first event: set them to do so, stepped first.
         self.early: list[int] = []
@@ -123,6 +128,8 @@ class SinglePassTrials:
         # the motion, not the size of their change); the others by their extrapolation.
         covered = {j for (_, (j, _)) in copies} | {s[0] for (s, _) in copies}
         self.averaged = self.held.averaged_sources(skip=covered)
+        if sloped:
+            self.averaged = sorted({*self.averaged, *(s for s in sloped if s[0] not in covered)})
         self.rate: dict[tuple[int, int], float] = {}  # largest rate of a copied source
 
     # -- the scheme's part of a macro step ---------------------------------------------
@@ -176,15 +183,29 @@ class SinglePassTrials:
         start, now = before.values, self.system.values
         ex, means = self.extrapolation, self.means
         row = []
-        for (s, k), averaged, _ in self.held.inputs[i]:
+        for (s, k), averaged, _, interpolated in self.held.inputs[i]:
             mean = means.get((s, k)) if s in done else None
-            if mean is not None:
+            if interpolated:
+                row.append(start[s][k])  # ramped from there (_feed)
+            elif mean is not None:
                 row.append(now[s][mean])
             elif averaged:
                 row.append(ex.mean((s, k), start[s][k], h))
             else:
                 row.append(start[s][k])
         return row
+
+    def _feed(self, i: int, h: float, before: Readings, done: set[int]) -> None:
+        """Set FMU i's inputs for a step h from ``before``, and the slopes of those it
+        ramps."""
+        self.system.feed(i, self._feed_row(i, h, before, done), before.ints)
+        if i in self.slopes:
+            indices, setter = self.slopes[i]
+            inputs, ex = self.held.inputs[i], self.extrapolation
+            if i in self.system.held_back:  # stepped as Jacobi steps it (masters/held_back.py)
+                setter([0.0] * len(indices))
+            else:
+                setter([ex.slope(inputs[k].source) for k in indices])
 
     def _one_pass(self, t: float, h: float, start: StepStart) -> _Pass:
         """Step every FMU once from t, those that end at their first event first (the
@@ -205,7 +226,7 @@ class SinglePassTrials:
                 if round_ > 0:
                     system.instances[i].set_state(start.state[i])
                     stats.rollbacks += 1
-                system.feed(i, self._feed_row(i, h_end, before, done), before.ints)
+                self._feed(i, h_end, before, done)
                 system.step(i, t, h_end)
                 stats.do_steps += 1
                 system.read(i)
@@ -221,7 +242,7 @@ class SinglePassTrials:
             if not again:
                 break
         for i in self.late:
-            system.feed(i, self._feed_row(i, h_end, before, done), before.ints)
+            self._feed(i, h_end, before, done)
             system.step(i, t, h_end)
         stats.do_steps += len(self.late)
         for i in self.late:  # the early ones were read after their step
@@ -271,5 +292,5 @@ class SinglePassTrials:
                     (vs, (vj, vk)) = speed
                     miss = max(miss, abs(end[vj][vk] - now[vs[0]][vs[1]]) * h)
                 worst = max(worst, miss / (tol * travel))
-        unannotated = held.change_ratio(before, held.unannotated, tol) if held.unannotated else 0.0
+        unannotated = held.change_ratio(before, held.unsloped, tol) if held.unsloped else 0.0
         return Estimate(max(worst, unannotated), unannotated > worst or not ex.second_order)

@@ -181,6 +181,7 @@ def build_torsion_body(
     fault: str | None = None,
     fault_time: float = 0.0,
     flags: bool = False,
+    input_derivatives: bool = False,
 ) -> Path:
     """Compile TorsionBody and pack it as ``dest/TorsionBody[-nostate][-deg][-<fault>].fmu``;
     return its path.
@@ -190,17 +191,20 @@ def build_torsion_body(
     parameter ``body.phi0`` is declared (and taken) in ``deg``, not SI.  ``fault``: one of
     ``FAULTS``, from the first doStep that starts at ``fault_time`` [s] (doStep faults and
     ``get_real``) or at once (the others).  ``flags``: with a Boolean and a String output
-    (``FLAG_VARIABLES``).
+    (``FLAG_VARIABLES``).  ``input_derivatives``: it takes the first derivative of
+    ``flange.w`` through fmi2SetRealInputDerivatives (``canInterpolateInputs="true"``).
     """
     if fault is not None and fault not in FAULTS:
         raise ValueError(f"unknown fault {fault!r}; expected one of {FAULTS}")
     name = MODEL_IDENTIFIER + ("" if can_get_set_state else "-nostate")
     name += "-deg" if phi0_in_degrees else ""
     name += "-flags" if flags else ""
+    name += "-deriv" if input_derivatives else ""
     defines = [
         *(["-DTORSION_BODY_FMU_STATE"] if can_get_set_state else []),
         *(["-DTORSION_BODY_PHI0_DEG"] if phi0_in_degrees else []),
         *(["-DTORSION_BODY_FLAGS"] if flags else []),
+        *(["-DTORSION_BODY_INPUT_DERIVATIVES"] if input_derivatives else []),
         *(
             [
                 f"-DTORSION_BODY_FAULT=FAULT_{fault.upper()}",
@@ -216,7 +220,7 @@ def build_torsion_body(
         "TORSION_BODY_GUID",
         defines,
         lambda guid: torsion_body_model_description(
-            guid, can_get_set_state, phi0_in_degrees, flags
+            guid, can_get_set_state, phi0_in_degrees, flags, input_derivatives
         ),
         Path(dest) / (name + (f"-{fault}" if fault else "") + ".fmu"),
         with_source=True,
@@ -278,7 +282,11 @@ def _build_c_fmu(
 
 
 def torsion_body_model_description(
-    guid: str, can_get_set_state: bool, phi0_in_degrees: bool = False, flags: bool = False
+    guid: str,
+    can_get_set_state: bool,
+    phi0_in_degrees: bool = False,
+    flags: bool = False,
+    input_derivatives: bool = False,
 ) -> bytes:
     """modelDescription.xml of TorsionBody (FMI 2.0, co-simulation)."""
     units = dict(UNITS)
@@ -302,6 +310,7 @@ def torsion_body_model_description(
         modelIdentifier=MODEL_IDENTIFIER,
         canHandleVariableCommunicationStepSize="true",
         canGetAndSetFMUstate="true" if can_get_set_state else "false",
+        canInterpolateInputs="true" if input_derivatives else "false",
         canSerializeFMUstate="false",
         providesDirectionalDerivative="false",
     )

@@ -224,6 +224,27 @@ def test_every_fmu_runs_at_every_form_of_resource_location(
         assert np.array_equal(table(out, f"{name}:run"), reference), name
 
 
+def test_input_derivatives_in_a_c_host(host: Path, tmp_path: Path) -> None:
+    """The brake load slipping under a torque ramped by fmi2SetRealInputDerivatives (its
+    loader serves them, with no Python in the host): speed v0 + ((T0 - T_b) t + dT t^2/2)/j,
+    the closed form of a shaft under a ramped torque against constant friction."""
+    j, t_b, v0, t0, dt, h, n = 0.05, 18.0, 5.0, 20.0, 3000.0, 1e-3, 20
+    path = build_fmu("BrakeLoad")
+    md = read_model_description(str(path))
+    speed = next(v for v in md.modelVariables if v.name == "speed")
+    torque = next(v for v in md.modelVariables if v.name == "torque")
+    values = {"j": j, "brake_torque": t_b, "speed0": v0, "torque": t0}
+    job = [f"plain 0 {n}", *fmu_lines("brake", path, unpack(path, tmp_path / "b"), values, [])]
+    job += [f"out r {speed.valueReference}", f"derivative {torque.valueReference} {dt!r}"]
+    (tmp_path / "job.txt").write_text("\n".join(job + [f"step {h!r}"]) + "\n")
+    out = run_host(host, tmp_path / "job.txt")
+    assert out[-1] == "done 0 failures", out[-20:]
+    t, v = table(out, "brake:run").T
+    assert len(t) == n + 1
+    exact = v0 + ((t0 - t_b) * t + 0.5 * dt * t * t) / j
+    assert np.abs(v - exact).max() <= 1e-13 * np.abs(exact).max()
+
+
 def test_a_resource_location_that_is_no_local_file_is_refused_by_name(
     host: Path, tmp_path: Path
 ) -> None:

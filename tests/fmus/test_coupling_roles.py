@@ -11,6 +11,7 @@ import pytest
 
 from components.base import Role, role_problem
 from fmus.build import build_fmu
+from fmus.host_loader import loader_plan
 from fmus.registry import FMU_RECORDS
 from orchestrator.model_info import ModelInfoError, model_info
 
@@ -65,7 +66,9 @@ def test_roles_are_read_from_a_built_fmu() -> None:
     assert brake.with_role("early_return") is None
     # FMI 2.0's own capabilities, as the description states them
     assert brake.can_handle_variable_step and brake.can_get_set_state
-    assert not brake.can_interpolate_inputs and brake.max_output_derivative_order == 0
+    assert brake.max_output_derivative_order == 0
+    # its loader serves input derivatives through torque_rate (test_loader_input_derivatives)
+    assert brake.can_interpolate_inputs == loader_plan().packs_loader
 
 
 def _with_description(source: Path, target: Path, old: str, new: str) -> Path:

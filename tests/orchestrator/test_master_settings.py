@@ -221,7 +221,9 @@ def test_the_midpoint_hold_ramps_the_inputs_whose_receivers_take_a_rate(
         ramps = master.scheme.ramps
         assert {system.names[j] for j, _, _ in ramps} == ramped
         for j, k, _ in ramps:
-            (source, slot), averaged, _ = master.scheme.held.inputs[j][k]
+            (source, slot), averaged, _, interpolated = master.scheme.held.inputs[j][k]
             assert averaged and system.real_names[source][slot] == "torque"
+            # our FMUs take it through torque_rate, not fmi2SetRealInputDerivatives
+            assert not interpolated and master.scheme.slopes == []
     finally:
         system.close()

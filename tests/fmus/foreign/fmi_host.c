@@ -14,6 +14,8 @@
  *   step <size>                       the communication step of the sequence (last fmu)
  *   set <r|i|b> <vr> <value>          a start value, set in initialization mode (last fmu)
  *   out <r|i> <vr>                    an output printed after each step (last fmu)
+ *   derivative <vr> <value>           the first derivative of a Real input, set by
+ *                                     fmi2SetRealInputDerivatives after initialization
  *   connect <r|i> <from instance> <vr> <to instance> <vr>
  *
  * Output lines: "<instance>:<label> <t> <values...>" (sequence) or "<instance> <t>
@@ -49,6 +51,8 @@ typedef struct {
     int n_sets;
     Var outs[MAX_VARS];
     int n_outs;
+    Var derivatives[MAX_VARS];
+    int n_derivatives;
     double h;
     fmi2Component c;
     fmi2InstantiateTYPE* instantiate;
@@ -68,6 +72,7 @@ typedef struct {
     fmi2SetFMUstateTYPE* set_state;
     fmi2FreeFMUstateTYPE* free_state;
     fmi2DoStepTYPE* do_step;
+    fmi2SetRealInputDerivativesTYPE* set_derivatives;
     fmi2GetTypesPlatformTYPE* types_platform;
     fmi2GetVersionTYPE* version;
 } Fmu;
@@ -159,6 +164,7 @@ static void load(Fmu* f) {
     f->set_state = function(f, "fmi2SetFMUstate");
     f->free_state = function(f, "fmi2FreeFMUstate");
     f->do_step = function(f, "fmi2DoStep");
+    f->set_derivatives = function(f, "fmi2SetRealInputDerivatives");
     f->types_platform = function(f, "fmi2GetTypesPlatform");
     f->version = function(f, "fmi2GetVersion");
     if (f->uri[0] == '\0') snprintf(f->uri, sizeof f->uri, "file://%s/resources", f->dir);
@@ -190,6 +196,12 @@ static void initialize(Fmu* f, fmi2Component c, double start) {
         }
     }
     CHECK(f->exit_init(c), "fmi2ExitInitializationMode", f->id);
+    for (int k = 0; k < f->n_derivatives; ++k) {
+        Var* v = &f->derivatives[k];
+        const fmi2Integer order = 1;
+        CHECK(f->set_derivatives(c, &v->vr, 1, &order, &v->value), "fmi2SetRealInputDerivatives",
+              f->id);
+    }
 }
 
 static void print_outputs(Fmu* f, fmi2Component c, const char* label, double t) {
@@ -429,6 +441,11 @@ int main(int argc, char** argv) {
             Fmu* f = &fmus[n_fmus - 1];
             Var* v = word[0] == 's' ? &f->sets[f->n_sets++] : &f->outs[f->n_outs++];
             sscanf(line, "%*s %c %u %lf", &v->type, &v->vr, &v->value);
+        } else if (strcmp(word, "derivative") == 0) {
+            Fmu* f = &fmus[n_fmus - 1];
+            Var* v = &f->derivatives[f->n_derivatives++];
+            v->type = 'r';
+            sscanf(line, "%*s %u %lf", &v->vr, &v->value);
         } else if (strcmp(word, "connect") == 0) {
             Connection* w = &connections[n_connections++];
             char from[64], to[64];

@@ -35,6 +35,12 @@
  *                           completes the step, then returns fmi2Discard with fmi2Terminated
  *                           true: fmi2LastSuccessfulTime is the step's end, as the Reference
  *                           FMU Stair ends on its last event)
+ *   TORSION_BODY_INPUT_DERIVATIVES  if defined, fmi2SetRealInputDerivatives takes the first
+ *                           derivative of flange.w (canInterpolateInputs="true"): over the
+ *                           next steps the flange moves at w_in + a*s (a the derivative, until
+ *                           set again), so the relative motion obeys J y'' + d y' + k y = -J a;
+ *                           a derivative of flange.phi is accepted and not used (the flange's
+ *                           angle follows its speed), other orders and variables are errors
  *   TORSION_BODY_FLAGS      if defined, two more outputs: the Boolean body.ahead (vr 0: the
  *                           body's angle is ahead of the flange's) and the String body.label
  *                           (vr 0: "TorsionBody")
@@ -78,6 +84,7 @@ typedef struct {
     fmi2Real time;
     Mode mode;
     fmi2Boolean terminated; /* the model asked to end the simulation */
+    fmi2Real dw_in;         /* the derivative of flange.w set (0: held) */
 } ModelState;
 
 /* Values of TORSION_BODY_FAULT (macros: the preprocessor compares them). */
@@ -157,6 +164,7 @@ static void set_start_values(Instance *inst) {
     inst->s.time = 0.0;
     inst->s.mode = MODE_INSTANTIATED;
     inst->s.terminated = fmi2False;
+    inst->s.dw_in = 0.0;
     update_outputs(inst);
 }
 
@@ -580,12 +588,29 @@ fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReferenc
 fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference vr[],
                                        size_t nvr, const fmi2Integer order[],
                                        const fmi2Real value[]) {
+#ifdef TORSION_BODY_INPUT_DERIVATIVES
+    Instance *inst = (Instance *)c;
+    size_t i;
+    if (inst == NULL) return fmi2Error;
+    for (i = 0; i < nvr; i++) {
+        if (order[i] != 1 || (vr[i] != VR_W_IN && vr[i] != VR_PHI_IN) || !isfinite(value[i])) {
+            LOG_ERROR(inst, "fmi2SetRealInputDerivatives: order %d of value reference %u is "
+                      "not taken (first derivatives of flange.phi and flange.w only)",
+                      (int)order[i], (unsigned)vr[i]);
+            return fmi2Error;
+        }
+    }
+    for (i = 0; i < nvr; i++)
+        if (vr[i] == VR_W_IN) inst->s.dw_in = value[i];
+    return fmi2OK;
+#else
     (void)vr;
     (void)nvr;
     (void)order;
     (void)value;
     LOG_ERROR((Instance *)c, "TorsionBody cannot interpolate inputs");
     return fmi2Error;
+#endif
 }
 
 fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReference vr[],
@@ -599,7 +624,13 @@ fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReferenc
     return fmi2Error;
 }
 
-/* Right-hand side of the relative motion: y' = v, v' = -(d v + k y) / J. */
+/* Right-hand side of the relative motion: y' = v, v' = -(d v + k y) / J (- a, the flange's
+ * acceleration, where input derivatives are taken). */
+#ifdef TORSION_BODY_INPUT_DERIVATIVES
+#define FLANGE_ACCELERATION(inst) ((inst)->s.dw_in)
+#else
+#define FLANGE_ACCELERATION(inst) 0.0
+#endif
 static fmi2Real relative_acceleration(const fmi2Real *r, fmi2Real y, fmi2Real v) {
     return -(r[VR_D] * v + r[VR_K] * y) / r[VR_J];
 }
@@ -609,7 +640,7 @@ fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint,
                       fmi2Boolean noSetFMUStatePriorToCurrentPoint) {
     Instance *inst = (Instance *)c;
     fmi2Real *r;
-    fmi2Real h = communicationStepSize, hs, y, v;
+    fmi2Real h = communicationStepSize, hs, y, v, a;
     fmi2Integer i, n;
     fmi2Status status = fmi2OK; /* fmi2Warning under FAULT_WARNING */
     (void)noSetFMUStatePriorToCurrentPoint;
@@ -684,18 +715,19 @@ fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint,
 
     n = inst->s.n_sub;
     hs = h / n;
+    a = FLANGE_ACCELERATION(inst);
     y = r[VR_PHI] - r[VR_PHI_IN];
     v = r[VR_W] - r[VR_W_IN];
     for (i = 0; i < n; i++) {
         fmi2Real k1y, k1v, k2y, k2v, k3y, k3v, k4y, k4v;
         k1y = v;
-        k1v = relative_acceleration(r, y, v);
+        k1v = relative_acceleration(r, y, v) - a;
         k2y = v + 0.5 * hs * k1v;
-        k2v = relative_acceleration(r, y + 0.5 * hs * k1y, v + 0.5 * hs * k1v);
+        k2v = relative_acceleration(r, y + 0.5 * hs * k1y, v + 0.5 * hs * k1v) - a;
         k3y = v + 0.5 * hs * k2v;
-        k3v = relative_acceleration(r, y + 0.5 * hs * k2y, v + 0.5 * hs * k2v);
+        k3v = relative_acceleration(r, y + 0.5 * hs * k2y, v + 0.5 * hs * k2v) - a;
         k4y = v + hs * k3v;
-        k4v = relative_acceleration(r, y + hs * k3y, v + hs * k3v);
+        k4v = relative_acceleration(r, y + hs * k3y, v + hs * k3v) - a;
         y = y + hs / 6.0 * (k1y + 2.0 * k2y + 2.0 * k3y + k4y);
         v = v + hs / 6.0 * (k1v + 2.0 * k2v + 2.0 * k3v + k4v);
     }
@@ -704,6 +736,10 @@ fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint,
         return fmi2Error;
     }
     r[VR_PHI_IN] = r[VR_PHI_IN] + r[VR_W_IN] * h;
+#ifdef TORSION_BODY_INPUT_DERIVATIVES
+    r[VR_PHI_IN] += 0.5 * a * h * h;
+    r[VR_W_IN] += a * h;
+#endif
     r[VR_PHI] = r[VR_PHI_IN] + y;
     r[VR_W] = r[VR_W_IN] + v;
     inst->s.time = currentCommunicationPoint + h;
