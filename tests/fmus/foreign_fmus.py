@@ -667,3 +667,46 @@ class ForeignFmus:
     torsion_body: Path  # TorsionBody.fmu, with fmi2Get/SetFMUstate
     stateless: Path  # TorsionBody-nostate.fmu, without
     container: Path  # TorsionBody-container.fmu: FMPy's container around the first, 1 ms step
+
+
+def foreign_scene(fmu: str, algorithm: str = "jacobi", step: str = "1 ms") -> str:
+    step_key = "first_step" if algorithm == "regime-aware" else "step"
+    return f"""
+[scene]
+name = "foreign"
+stop = "0.2 s"
+
+[fmus.a]
+component = "Inertia"
+parameters = {{ J = "2e-4 kg*m^2", w0 = "10 rad/s" }}
+
+[fmus.c]
+fmu = "{fmu}"
+parameters = {{ "body.J" = "1e-4 kg*m^2", "spring.k" = "2 N*m/rad", "spring.d" = 2e-3, n_sub = 10 }}
+inputs = {{ "flange.phi" = 0.0, "flange.w" = "10 rad/s" }}
+
+[[connections]]
+from = "c.flange.tau"
+to = "a.tau"
+
+[[connections]]
+from = "a.phi"
+to = "c.flange.phi"
+
+[[connections]]
+from = "a.w"
+to = "c.flange.w"
+
+[master]
+algorithm = "{algorithm}"
+{step_key} = "{step}"
+
+[output]
+record = ["a.phi", "a.w", "c.body.phi", "c.body.w", "c.flange.tau"]
+"""
+
+
+def write_scene(directory: Path, text: str) -> Path:
+    path = directory / "scene.toml"
+    path.write_text(text)
+    return path

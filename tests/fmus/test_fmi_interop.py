@@ -16,6 +16,7 @@ import foreign_fmus
 import numpy as np
 import pytest
 from fmpy import read_model_description, simulate_fmu
+from foreign_fmus import foreign_scene, write_scene
 
 import fmus.registry as registry
 from fmus.build import build_fmu
@@ -31,49 +32,6 @@ needs_cc = pytest.mark.skipif(foreign_fmus.c_compiler() is None, reason="no C co
 # Body A (our Inertia) and the foreign TorsionBody: the two-inertia scene, other tool.
 A = {"J_a": 2e-4, "phi0_a": 0.0, "w0_a": 10.0}
 B = {"J": 1e-4, "k": 2.0, "d": 2e-3, "phi0": 0.0, "w0": 0.0, "n_sub": 10}
-
-
-def foreign_scene(fmu: str, algorithm: str = "jacobi", step: str = "1 ms") -> str:
-    step_key = "first_step" if algorithm == "regime-aware" else "step"
-    return f"""
-[scene]
-name = "foreign"
-stop = "0.2 s"
-
-[fmus.a]
-component = "Inertia"
-parameters = {{ J = "2e-4 kg*m^2", w0 = "10 rad/s" }}
-
-[fmus.c]
-fmu = "{fmu}"
-parameters = {{ "body.J" = "1e-4 kg*m^2", "spring.k" = "2 N*m/rad", "spring.d" = 2e-3, n_sub = 10 }}
-inputs = {{ "flange.phi" = 0.0, "flange.w" = "10 rad/s" }}
-
-[[connections]]
-from = "c.flange.tau"
-to = "a.tau"
-
-[[connections]]
-from = "a.phi"
-to = "c.flange.phi"
-
-[[connections]]
-from = "a.w"
-to = "c.flange.w"
-
-[master]
-algorithm = "{algorithm}"
-{step_key} = "{step}"
-
-[output]
-record = ["a.phi", "a.w", "c.body.phi", "c.body.w", "c.flange.tau"]
-"""
-
-
-def write_scene(directory: Path, text: str) -> Path:
-    path = directory / "scene.toml"
-    path.write_text(text)
-    return path
 
 
 def assert_matches_reference(result, step: float = 1e-3) -> None:

@@ -13,7 +13,7 @@ from pathlib import Path
 import foreign_fmus
 import numpy as np
 import pytest
-from test_fmi_interop import foreign_scene, write_scene
+from foreign_fmus import foreign_scene, write_scene
 
 from orchestrator import capabilities
 from orchestrator.model_info import model_info
