@@ -26,7 +26,6 @@ from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
-from scipy.optimize import brentq
 
 from .base import Variable, design_parameter
 from .clock_train_kinematics import M739_MESH1, M739_MESH2, M739_TRAIN, ClockMesh, ClockTrain
@@ -241,6 +240,8 @@ def _first_touch(m: ClockMesh, lo: float, hi: float) -> float | None:
         return None
     for k in range(100):
         if gaps[k] > 0.0 >= gaps[k + 1]:
+            from scipy.optimize import brentq  # here: scipy.optimize costs 0.3-0.6 s to import
+
             return float(brentq(m.sensing_gap, grid[k], grid[k + 1], xtol=1e-15))
     return None
 

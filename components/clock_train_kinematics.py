@@ -44,7 +44,6 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.optimize import brentq
 
 from .units import INCH
 
@@ -258,6 +257,8 @@ class ClockMesh:
             grid = t + p * np.linspace(0.0, 1.5, 61)
             gaps = [self.sensing_gap(x) for x in grid]
             k = next(i for i in range(60) if gaps[i] > 0.0 >= gaps[i + 1])
+            from scipy.optimize import brentq  # here: scipy.optimize costs 0.3-0.6 s to import
+
             self._cache["handover"] = brentq(self.sensing_gap, grid[k], grid[k + 1], xtol=1e-15)
         return self._cache["handover"]
 

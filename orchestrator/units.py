@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import pickle
 import re
+import shutil
 import sys
 from functools import cache
 
@@ -30,14 +31,19 @@ pint = _import_pint()
 def _unit_registry() -> pint.UnitRegistry:
     """pint's registry, its parsed definitions cached beside the FMUs: building it from the
     definition files costs 0.2-0.8 s a process, loading the cache a tenth of that. A cache
-    that cannot be written or read (read-only, or half-written by another process at this
-    moment) is passed over, and the registry built from the files as before."""
+    that cannot be read (half-written by a process that died) is cleared and written again;
+    one that cannot be written is passed over, and the registry built from the files."""
     from fmus.build import default_cache_dir  # the FMU cache's location, read once here
 
-    try:
-        return pint.UnitRegistry(cache_folder=default_cache_dir() / "units")
-    except (OSError, EOFError, pickle.UnpicklingError, AttributeError, ValueError):
-        return pint.UnitRegistry()
+    folder = default_cache_dir() / "units"
+    for _ in range(2):
+        try:
+            return pint.UnitRegistry(cache_folder=folder)
+        except (EOFError, pickle.UnpicklingError, AttributeError, ValueError):
+            shutil.rmtree(folder, ignore_errors=True)
+        except OSError:
+            break
+    return pint.UnitRegistry()
 
 
 UREG = _unit_registry()

@@ -34,6 +34,9 @@ def test_cached_registry_converts_as_built_one(tmp_path: Path) -> None:
     for pickled in (tmp_path / "units").glob("*.pickle"):
         pickled.write_bytes(pickled.read_bytes()[:100])  # a writer that died mid-write
     assert _convert(tmp_path) == first
+    # ... and the cache is written again, whole
+    for pickled in (tmp_path / "units").glob("*.pickle"):
+        assert len(pickled.read_bytes()) > 100
     # 0.4701 in, and 1 lbf*in*s^2 with the exact pound-force 4.4482216152605 N; dask is not
     # imported by the unit conversions
     assert first == f"0.01194054 {4.4482216152605 * 0.0254!r} False"
