@@ -31,7 +31,13 @@ from orchestrator.masters.registry import (
     step_keys,
 )
 from orchestrator.model_info import ModelInfo, ModelInfoError, VariableInfo, model_info
-from orchestrator.regular_files import TOML_LIMIT, NotARegularFile, read_regular
+from orchestrator.regular_files import (
+    ARCHIVE_LIMIT,
+    TOML_LIMIT,
+    NotARegularFile,
+    check_regular,
+    read_regular,
+)
 from orchestrator.scene_model import (
     Connection,
     FmuSpec,
@@ -458,8 +464,15 @@ class _Loader:
         if "fmu" in entry:
             text = self.string(entry, "fmu", f"{key}.fmu")
             path = (self.path.parent / text).resolve()
-            if not path.is_file():
+            if not path.exists():
                 raise self.fail(f"{key}.fmu", f"no FMU file at {path}")
+            try:
+                check_regular(path, ARCHIVE_LIMIT)  # a pipe or a device would hang the unzip
+            except IsADirectoryError:
+                why = f"{path} is a directory; expected an FMU file"
+                raise self.fail(f"{key}.fmu", why) from None
+            except NotARegularFile as exc:
+                raise self.fail(f"{key}.fmu", f"{path} {exc.strerror}") from None
             return None, path
         component = self.string(entry, "component", f"{key}.component")
         if component not in FMU_RECORDS:

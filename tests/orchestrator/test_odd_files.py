@@ -126,3 +126,16 @@ def test_export_force_never_replaces_a_file_the_scene_reads(tmp_path: Path, caps
     err = _one_line(capsys, ["export", str(scene), str(tmp_path / "torque.csv"), "--force"])
     assert "is the signal file of fmus.a.tau; an export never replaces" in err
     assert (tmp_path / "torque.csv").read_text().startswith("time [s],tau [N*m]")
+
+
+@pytest.mark.parametrize("kind", ["pipe", "directory"])
+def test_an_fmu_that_is_no_regular_file_is_refused_by_name(tmp_path, capsys, kind) -> None:
+    odd = tmp_path / "Model.fmu"
+    if kind == "pipe":
+        os.mkfifo(odd)
+    else:
+        odd.mkdir()
+    (tmp_path / "torque.csv").write_text("time [s],tau [N.m]\n0,0\n")
+    err = _one_line(capsys, ["check", str(_scene(tmp_path, 'fmu = "Model.fmu"'))])
+    expected = "is a named pipe, not a regular file" if kind == "pipe" else "is a directory"
+    assert "[fmus.a.fmu]" in err and str(odd) in err and expected in err, err
