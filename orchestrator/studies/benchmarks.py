@@ -1,7 +1,8 @@
 """Benchmarks (not tests): costs measured against a baseline taken in the same run.
 
 ``mechcosim bench overhead``: the cost of one FMU doStep through fmpy and of one master
-macro step, against the same physics stepped as plain Python objects.
+macro step, against the same physics stepped as plain Python objects; then each layer's
+cost per call in a run of the M739 scene (``layer_costs``).
 """
 
 from __future__ import annotations
@@ -98,6 +99,18 @@ def print_overhead() -> None:
         ref = pair if name.startswith("coupled") else base
         print(f"{name:66s} {seconds * 1e6:9.2f} {seconds / ref:8.1f}x")
     print("ratios: against the plain-Python step of the same physics, measured in this run")
+    print_m739_layers()
+
+
+def print_m739_layers() -> None:
+    """Each layer's own cost per call in the M739 scene as written (no reference), timed in
+    its second run (the first loads the FMUs and warms the caches)."""
+    from orchestrator.studies.layer_costs import measure, print_layer_costs
+
+    scene = load_scene(SCENARIOS / "m739.toml", {})
+    out = Path("runs") / "bench_overhead_m739"
+    measure(scene, out)
+    print_layer_costs(measure(scene, out), "M739 co-simulation as written")
 
 
 def family_model(scene_file: str) -> tuple[Headline, Callable[[float], Outcome]]:
