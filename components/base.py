@@ -152,7 +152,9 @@ class SnapshotPlan:
         for name, links in self.objects.items():
             if name in snap:
                 obj = snap[name]
-                fields = {k: v for k, v in obj.__dict__.items() if k not in links}
+                fields = dict(obj.__dict__)  # a copy at C speed, then the links out
+                for link in links:
+                    fields.pop(link, None)
                 snap[name] = (type(obj), fields)
         return snap
 

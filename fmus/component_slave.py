@@ -36,6 +36,7 @@ import atexit
 import ctypes
 import importlib
 import math
+import operator
 import os
 import sys
 import threading
@@ -109,7 +110,17 @@ class ComponentSlave(Fmi2Slave):
         self._types: list[str] = []
         self._causalities: list[str] = []
         self._inputs: set[int] = set()
+        # Inputs set since the outputs were last computed: a step that does not take its
+        # inputs itself updates the outputs first (``do_step``).
         self._feedthrough_stale = False
+        # The outputs a get would answer are out of date: an input some output depends on
+        # (``Variable.depends_on``) changed since they were computed.  A get recomputes them
+        # only then; sets of other inputs, or of the same values onto outputs computed from
+        # those very inputs, keep them.
+        self._outputs_stale = False
+        # The outputs were last computed from the inputs as they are (initialization or
+        # update_outputs), not by a step: setting an input to its value again changes none.
+        self._outputs_from_inputs = False
         self._initializing = False
         self._initialized = False  # initialization mode left: fixed parameters are fixed
         self._init_stale = False
@@ -134,6 +145,16 @@ class ComponentSlave(Fmi2Slave):
         self._settable_after = {
             kind: frozenset(vrs & self._inputs) for kind, vrs in self._settable_before.items()
         }
+        by_name = {name: vr for vr, name in enumerate(self._names)}
+        self._feeds_outputs = frozenset(
+            by_name[name]
+            for v in self.component_class.VARIABLES
+            if v.causality == "output"
+            for name in v.depends_on
+            if by_name.get(name) in self._inputs
+        )
+        # value references -> a function reading them off the component, per type
+        self._readers: dict[str, dict[tuple[int, ...], Any]] = {"Real": {}, "Integer": {}}
 
     def _register(self, var: Any) -> None:
         comp = self.model
@@ -203,7 +224,8 @@ class ComponentSlave(Fmi2Slave):
         self._initializing = False
         self._initialized = True
         self._init_stale = False
-        self._feedthrough_stale = False
+        self._feedthrough_stale = self._outputs_stale = False
+        self._outputs_from_inputs = True
         self._t_end = self._start_time
 
     def _refresh(self, function: str) -> bool:
@@ -214,10 +236,11 @@ class ComponentSlave(Fmi2Slave):
                 if not self._computed(function, initialize=True):
                     return False
                 self._init_stale = False
-        elif self._feedthrough_stale:
+        elif self._outputs_stale:
             if not self._computed(function, initialize=False):
                 return False
-        self._feedthrough_stale = False
+            self._feedthrough_stale = self._outputs_stale = False
+            self._outputs_from_inputs = True
         return True
 
     def _computed(self, function: str, initialize: bool) -> bool:
@@ -261,7 +284,7 @@ class ComponentSlave(Fmi2Slave):
             if self._feedthrough_stale and not self.model.STEP_TAKES_INPUTS:
                 self.model.update_outputs()
             self.model.step(current_time, step_size)
-            self._feedthrough_stale = False
+            self._feedthrough_stale = self._outputs_stale = self._outputs_from_inputs = False
         except Exception as exc:  # noqa: BLE001 - the step cannot be completed: say why
             # fmi2Discard; nothing of the step is kept, so the last successful time is its
             # start, which pythonfmu's runtime answers to fmi2GetRealStatus
@@ -303,24 +326,55 @@ class ComponentSlave(Fmi2Slave):
             )
 
     def get_real(self, vrs: list[int]) -> list[float]:
-        if not self._readable["Real"].issuperset(vrs):
-            self._bad_reference("fmi2GetReal", "Real", vrs, self._readable["Real"])
+        key = tuple(vrs)
+        read = self._readers["Real"].get(key)
+        if read is None:
+            if not self._readable["Real"].issuperset(vrs):
+                self._bad_reference("fmi2GetReal", "Real", vrs, self._readable["Real"])
+                return [0.0] * len(vrs)
+            read = self._reader("Real", key, float)
+        if (self._outputs_stale or self._initializing) and not self._refresh("fmi2GetReal"):
             return [0.0] * len(vrs)
-        if (self._feedthrough_stale or self._initializing) and not self._refresh("fmi2GetReal"):
-            return [0.0] * len(vrs)
-        comp = self.model
-        names = self._names
-        return [float(getattr(comp, names[vr])) for vr in vrs]
+        return read(self.model)
 
     def get_integer(self, vrs: list[int]) -> list[int]:
-        if not self._readable["Integer"].issuperset(vrs):
-            self._bad_reference("fmi2GetInteger", "Integer", vrs, self._readable["Integer"])
+        key = tuple(vrs)
+        read = self._readers["Integer"].get(key)
+        if read is None:
+            if not self._readable["Integer"].issuperset(vrs):
+                self._bad_reference("fmi2GetInteger", "Integer", vrs, self._readable["Integer"])
+                return [0] * len(vrs)
+            read = self._reader("Integer", key, int)
+        if (self._outputs_stale or self._initializing) and not self._refresh("fmi2GetInteger"):
             return [0] * len(vrs)
-        if (self._feedthrough_stale or self._initializing) and not self._refresh("fmi2GetInteger"):
-            return [0] * len(vrs)
-        comp = self.model
-        names = self._names
-        return [int(getattr(comp, names[vr])) for vr in vrs]
+        return read(self.model)
+
+    def _reader(self, kind: str, vrs: tuple[int, ...], cast: type) -> Any:
+        """A function reading the variables ``vrs`` (valid ones, of ``kind``) off the
+        component as a list of ``cast``; kept for the next call with the same references."""
+        readers = self._readers[kind]
+        if len(readers) >= READERS_KEPT:  # a host asking ever other sets: no unbounded memo
+            readers.clear()
+        names = [self._names[vr] for vr in vrs]
+        if len(names) == 1:
+            one = operator.attrgetter(names[0])
+
+            def read(comp: Any) -> list:
+                return [cast(one(comp))]
+
+        elif names:
+            many = operator.attrgetter(*names)
+
+            def read(comp: Any) -> list:
+                return list(map(cast, many(comp)))
+
+        else:
+
+            def read(comp: Any) -> list:
+                return []
+
+        readers[vrs] = read
+        return read
 
     def set_real(self, vrs: list[int], values: list[float]) -> None:
         settable = (self._settable_after if self._initialized else self._settable_before)["Real"]
@@ -333,22 +387,36 @@ class ComponentSlave(Fmi2Slave):
             )
             self._refuse(f"fmi2SetReal: {self._names[vr]} = {value} is not finite")
             return
-        comp = self.model
-        names = self._names
-        for vr, value in zip(vrs, values, strict=True):
-            setattr(comp, names[vr], float(value))
-        self._feedthrough_stale = self._init_stale = True
+        self._set(vrs, values, float)
 
     def set_integer(self, vrs: list[int], values: list[int]) -> None:
         settable = (self._settable_after if self._initialized else self._settable_before)["Integer"]
         if not settable.issuperset(vrs):
             self._bad_reference("fmi2SetInteger", "Integer", vrs, settable)
             return
+        self._set(vrs, values, int)
+
+    def _set(self, vrs: list[int], values: list, cast: type) -> None:
+        """Set valid, checked values and say which outputs they leave out of date."""
         comp = self.model
         names = self._names
+        if not self._initialized:  # initialization recomputes everything from what is set
+            for vr, value in zip(vrs, values, strict=True):
+                setattr(comp, names[vr], cast(value))
+            self._feedthrough_stale = self._init_stale = self._outputs_stale = True
+            return
+        stale = self._outputs_stale
+        feeds = self._feeds_outputs
+        from_inputs = self._outputs_from_inputs
         for vr, value in zip(vrs, values, strict=True):
-            setattr(comp, names[vr], int(value))
+            name = names[vr]
+            value = cast(value)
+            if not stale and vr in feeds:
+                # after a step the outputs are the step's: a set recomputes them, as ever
+                stale = not from_inputs or not _same(getattr(comp, name), value)
+            setattr(comp, name, value)
         self._feedthrough_stale = self._init_stale = True
+        self._outputs_stale = stale
 
     # no Boolean or String variables: an empty call is answered, any reference refused
     def get_boolean(self, vrs: list[int]) -> list[bool]:
@@ -374,7 +442,7 @@ class ComponentSlave(Fmi2Slave):
         return {
             "fmu": self.component,
             "component": self.model.get_state(),
-            "stale": self._feedthrough_stale,
+            "stale": (self._feedthrough_stale, self._outputs_stale, self._outputs_from_inputs),
             "init_stale": self._init_stale,
             "phase": (self._initializing, self._initialized),
             "time": (self._start_time, self._t_end, self._last_h),
@@ -389,10 +457,19 @@ class ComponentSlave(Fmi2Slave):
             )
             return
         self.model.set_state(state["component"])
-        self._feedthrough_stale = state["stale"]
+        self._feedthrough_stale, self._outputs_stale, self._outputs_from_inputs = state["stale"]
         self._init_stale = state["init_stale"]
         self._initializing, self._initialized = state["phase"]
         self._start_time, self._t_end, self._last_h = state["time"]
+
+
+#: Reading functions kept per type (one per list of value references a host asks for).
+READERS_KEPT = 64
+
+
+def _same(old: float, new: float) -> bool:
+    """Whether a set value is the one held, bit for bit (0.0 and -0.0 differ)."""
+    return old == new and (old != 0.0 or math.copysign(1.0, old) == math.copysign(1.0, new))
 
 
 #: A step starts where the last ended, up to this relative difference (a host that computes

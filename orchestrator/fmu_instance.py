@@ -77,6 +77,9 @@ class FmiCallError(RunError):
 # which passes each message to its instance by the componentEnvironment it was given.
 _LOGS: dict[int, Callable[[int, str, str], None]] = {}
 _ENVIRONMENTS = itertools.count(1)
+#: The FMI functions that set variables (what a get answers then changes only by the
+#: outputs depending on them); fmi2SetRealInputDerivatives among them.
+_SETS = ("fmi2SetReal", "fmi2SetInteger", "fmi2SetBoolean", "fmi2SetString")
 
 
 def _log_message(env: Any, instance: bytes, status: int, category: bytes, message: bytes) -> None:
@@ -130,6 +133,11 @@ class FmuInstance:
         self.name = instance_name
         self.path = Path(fmu_path)
         self.restores = 0  # states restored so far (inputs set before are no longer held)
+        #: calls so far that may change what a get answers (any but a get), and of those the
+        #: ones that may change more than the outputs of the inputs set (any but a set):
+        #: a master that read the values after the last such call need not read them again
+        self.changes = 0
+        self.moves = 0
         md, unzip_dir = _unpacked(str(self.path))
         self.model_description = md
         self.variables = {v.name: v for v in md.modelVariables}
@@ -293,6 +301,10 @@ class FmuInstance:
         idle = flight.call_word(slot, "")
 
         def noted(name: str, *args: Any) -> Any:
+            if not name.startswith("fmi2Get"):
+                self.changes += 1
+                if not name.startswith(_SETS):
+                    self.moves += 1
             words[at] = flight.call_word(slot, name)
             try:
                 status = call(name, *args)
@@ -314,6 +326,8 @@ class FmuInstance:
         if name == "fmi2DoStep":  # the time too: where the FMU is, should it crash
 
             def do_step(component: Any, t: float, h: float, last: int) -> int:
+                self.changes += 1
+                self.moves += 1
                 words[at] = busy
                 reals[at_time] = t
                 status = raw(component, t, h, last)
@@ -327,7 +341,27 @@ class FmuInstance:
 
             return do_step
 
+        if name.startswith(_SETS):
+
+            def set_values(*args: Any) -> int:
+                self.changes += 1
+                words[at] = busy
+                status = raw(*args)
+                words[at] = idle
+                if status:
+                    if status > 1:
+                        raise self._failed(name, status)
+                    self.log.returned_warning(name, self._flight.time)
+                return status
+
+            return set_values
+
+        changes = not name.startswith("fmi2Get") and name != "fmi2FreeFMUstate"
+
         def call(*args: Any) -> int:
+            if changes:  # fmi2SetFMUstate
+                self.changes += 1
+                self.moves += 1
             words[at] = busy
             status = raw(*args)
             words[at] = idle

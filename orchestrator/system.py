@@ -42,6 +42,7 @@ class CoupledSystem:
     """FMU instances in master order with their connections and recorded signals."""
 
     _dependent: list[int] | None = None  # see input_dependent
+    _dependent_kinds: list[tuple[bool, ...]] = []  # per instance: Reals, Integers, Booleans
 
     def __init__(self, scene: Scene, fmu_paths: dict[str, Path] | None = None) -> None:
         """``fmu_paths`` (instance -> FMU file) overrides the files the scene names."""
@@ -121,6 +122,8 @@ class CoupledSystem:
         #: per instance, (its restore count, values) last set through ``feed``
         self._fed_reals: list[tuple[int, list[float]] | None] = [None for _ in self.names]
         self._fed_ints: list[tuple[int, list[int]] | None] = [None for _ in self.names]
+        #: per instance, its (changes, moves) counts when its values were last read
+        self._read_at: list[tuple[int, int] | None] = [None for _ in self.names]
         self.values: list[list[float]] = [[] for _ in self.names]
         self.ints: list[list[int]] = [[] for _ in self.names]
         self.bools: list[list[int]] = [[] for _ in self.names]
@@ -209,6 +212,32 @@ class CoupledSystem:
         get = self._get_bools[i]
         if get is not None:
             self.bools[i] = get()
+        inst = self.instances[i]
+        self._read_at[i] = (inst.changes, inst.moves)
+
+    def _read_again(self, i: int) -> None:
+        """Read instance i again after a feed: nothing if no call since its last read could
+        change its values; if only sets were made since, only its values that may depend on
+        inputs (Integers, say, that are the FMU's own state stay as read)."""
+        if self.held_back and i in self.held_back:
+            return
+        inst, at = self.instances[i], self._read_at[i]
+        if at is None or at[1] != inst.moves:
+            self.read(i)
+            return
+        if at[0] == inst.changes:
+            return
+        reals, ints, bools = self._dependent_kinds[i]
+        get = self._get_reals[i]
+        if reals and get is not None:
+            self.values[i] = get()
+        get = self._get_ints[i]
+        if ints and get is not None:
+            self.ints[i] = get()
+        get = self._get_bools[i]
+        if bools and get is not None:
+            self.bools[i] = get()
+        self._read_at[i] = (inst.changes, inst.moves)
 
     def input_dependent(self) -> list[int]:
         """The instances some of whose read values may change when their inputs are set (an
@@ -216,7 +245,11 @@ class CoupledSystem:
         but an output): those to read again after a feed.  Our crank drive, for one, has
         none: its outputs follow its state."""
         if self._dependent is None:
-            self._dependent = [i for i in range(len(self.names)) if self._reads_feedthrough(i)]
+            self._dependent_kinds = [
+                tuple(self._reads_feedthrough(i, names[i]) for names in self._read_names)
+                for i in range(len(self.names))
+            ]
+            self._dependent = [i for i, kinds in enumerate(self._dependent_kinds) if any(kinds)]
         return self._dependent
 
     def exchange(self) -> None:
@@ -225,11 +258,16 @@ class CoupledSystem:
         for i in range(len(self.instances)):
             self.feed(i)
         for i in self.input_dependent():
-            self.read(i)
+            self._read_again(i)
 
-    def _reads_feedthrough(self, i: int) -> bool:
+    @property
+    def _read_names(self) -> tuple[list[list[str]], ...]:
+        return self.real_names, self.int_names, self.bool_names
+
+    def _reads_feedthrough(self, i: int, names: list[str]) -> bool:
+        """Whether some of ``names``, values read from instance i, may depend on its inputs."""
         model = self.models[i]
-        for name in (*self.real_names[i], *self.int_names[i], *self.bool_names[i]):
+        for name in names:
             var = model.variables.get(name)
             if var is None or var.causality != "output":
                 return True

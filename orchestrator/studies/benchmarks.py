@@ -1,7 +1,8 @@
 """Benchmarks (not tests): costs measured against a baseline taken in the same run.
 
 ``mechcosim bench overhead``: the cost of one FMU doStep through fmpy and of one master
-macro step, against the same physics stepped as plain Python objects.
+macro step, against the same physics stepped as plain Python objects; then each layer's
+cost per call in a run of the M739 scene (``layer_costs``).
 """
 
 from __future__ import annotations
@@ -44,16 +45,22 @@ def overhead(n: int = 20000) -> dict[str, float]:
     fmu.initialize(0.0, 1.0, {"J": 2e-4, "w0": 10.0})
     tau_ref, out_refs = fmu.refs(["tau"]), fmu.refs(["phi", "w"])
 
+    # The FMU's steps follow on in time, as an FMU requires: each starts where the last ended.
+    h, at = 1e-5, [0]
+
     def through_fmu(count: int) -> None:
-        step = fmu.do_step
-        for _ in range(count):
-            step(0.0, 1e-5)
+        step, first = fmu.do_step, at[0]
+        for k in range(first, first + count):
+            step(k * h, h)
+        at[0] = first + count
 
     def exchange_and_step(count: int) -> None:
-        for _ in range(count):
+        first = at[0]
+        for k in range(first, first + count):
             fmu.set_real(tau_ref, [0.0])
-            fmu.do_step(0.0, 1e-5)
+            fmu.do_step(k * h, h)
             fmu.get_real(out_refs)
+        at[0] = first + count
 
     # Coupled pair stepped as plain Python (the master's work without FMI) ...
     a, b = Inertia(J=2e-4, w0=10.0), SpringDamperInertia(J=1e-4, k=2.0, d=2e-3)
@@ -98,6 +105,18 @@ def print_overhead() -> None:
         ref = pair if name.startswith("coupled") else base
         print(f"{name:66s} {seconds * 1e6:9.2f} {seconds / ref:8.1f}x")
     print("ratios: against the plain-Python step of the same physics, measured in this run")
+    print_m739_layers()
+
+
+def print_m739_layers() -> None:
+    """Each layer's own cost per call in the M739 scene as written (no reference), timed in
+    its second run (the first loads the FMUs and warms the caches)."""
+    from orchestrator.studies.layer_costs import measure, print_layer_costs
+
+    scene = load_scene(SCENARIOS / "m739.toml", {})
+    out = Path("runs") / "bench_overhead_m739"
+    measure(scene, out)
+    print_layer_costs(measure(scene, out), "M739 co-simulation as written")
 
 
 def family_model(scene_file: str) -> tuple[Headline, Callable[[float], Outcome]]:

@@ -101,3 +101,39 @@ def test_a_hosts_tolerance_is_the_fmus_unless_the_parameter_is_set() -> None:
         assert train.get("tolerance") == 1e-8  # the FMU's own default
     finally:
         system.close()
+
+
+def _counting_gets(system: CoupledSystem) -> list[tuple[int, str]]:
+    """Wrap every prepared get of ``system``: the list of (instance, kind) read."""
+    gets: list[tuple[int, str]] = []
+    for kind, getters in (("real", system._get_reals), ("int", system._get_ints)):
+        for i, get in enumerate(getters):
+            if get is not None:
+                getters[i] = lambda get=get, i=i, kind=kind: (gets.append((i, kind)), get())[1]
+    return gets
+
+
+def test_an_exchange_reads_again_only_what_a_call_since_may_have_changed() -> None:
+    system = CoupledSystem(load_scene(SCENARIOS / "m739.toml"))
+    try:
+        system.initialize()
+        verge, train = system.index["verge"], system.index["train"]
+        gets = _counting_gets(system)
+        system.exchange()  # everything read after the last feed: nothing to read again
+        assert gets == []
+        system.step(train, 0.0, 1e-6)
+        system.read(train)
+        del gets[:]
+        system.exchange()
+        # The verge was given the train's new state: its Reals depend on it, its regime
+        # and impact count (its own state) do not; the train was set nothing new.
+        assert gets == [(verge, "real")]
+        after = [list(v) for v in system.values], [list(v) for v in system.ints]
+        system.read_all()  # a full read gives the very same values
+        assert ([list(v) for v in system.values], [list(v) for v in system.ints]) == after
+        system.step(verge, 0.0, 1e-6)  # stepped, not read: an exchange reads it whole
+        del gets[:]
+        system.exchange()
+        assert (verge, "real") in gets and (verge, "int") in gets
+    finally:
+        system.close()
