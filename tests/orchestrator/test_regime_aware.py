@@ -20,6 +20,8 @@ def run(tmp_path, fmu_cache, **overrides):
     return run_file(SCENE, tmp_path / "run", overrides)
 
 
+# a convergence study over tolerances: long validation
+@pytest.mark.slow
 def test_error_follows_the_tolerance_with_inputs_held_at_the_step_start(
     tmp_path, fmu_cache
 ) -> None:

@@ -240,6 +240,8 @@ def test_shaft_stop_time_converges(fmu_cache, tmp_path):
         assert fine < coarse / 1.5, errs
 
 
+# Run 2's reference: another operating point, long validation
+@pytest.mark.slow
 def test_run2_reference_clutch_unloads_mid_feed(references):
     # 300 rpm with the heavy strip: the windup transient exceeds the preload and the clutch
     # disengages during the feed (the thesis's min brake torque criterion, eqs 65-67).
