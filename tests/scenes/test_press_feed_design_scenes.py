@@ -65,6 +65,7 @@ def _agrees(result) -> None:
     assert acc["event_count_difference"] == 0
 
 
+@pytest.mark.slow  # one more design point against its reference: long validation
 def test_a_second_crank_radius_agrees_with_its_reference(tmp_path, fmu_cache) -> None:
     overrides = {
         "fmus.drive.parameters.a1": "1.05 in",

@@ -42,9 +42,11 @@ MIDPOINT = {
     "master.tolerance": 1e-3,
 }
 SINGLE_PASS = {**MIDPOINT, "master.input_hold": "extrapolated"}
-#: Both schemes, the single pass in the slow suite (the default stays under 2 minutes).
+#: Both schemes, in the slow suite (the default stays under 2 minutes; the regime-aware
+#: master on the press feed's roles is covered there by tests/fmus/test_input_derivatives.py
+#: and tests/orchestrator/test_exchange.py).
 SCHEMES = [
-    pytest.param(MIDPOINT, id="midpoint"),
+    pytest.param(MIDPOINT, id="midpoint", marks=pytest.mark.slow),
     pytest.param(SINGLE_PASS, id="single-pass", marks=pytest.mark.slow),
 ]
 SLOW_SCHEMES = [pytest.param(*p.values, id=p.id, marks=pytest.mark.slow) for p in SCHEMES]
@@ -167,3 +169,15 @@ def test_run1_error_shrinks_with_the_tolerance(fmu_cache, tmp_path):
         errors.append((r.accuracy["trajectory_error"], r.accuracy["event_time_error"]))
     for coarse, fine in zip(errors, errors[1:], strict=False):
         assert fine[0] < coarse[0] / 2 and fine[1] < coarse[1], errors
+
+
+def test_one_crank_turn_of_run1_under_the_midpoint_hold(runs):
+    """The default suite's run of the press feed under the regime-aware master (its ramped
+    torque and step means): one crank turn of Run 1, against its reference to that stop."""
+    r, _ = runs("press_feed_run1.toml", {**MIDPOINT, "scene.stop": "0.3 s"})
+    assert r.status == "completed", r.message
+    assert r.accuracy["trajectory_error"] < 5e-3
+    assert r.accuracy["event_time_error"] < 1e-4
+    assert r.value("energy_residual") < 1e-3
+    (cycle,) = run_regime_sequences(r.scene, r.header, r.data)
+    assert set(cycle) == {WINDUP, FEED, UNWIND, OVERRUN}, cycle
