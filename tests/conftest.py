@@ -9,9 +9,17 @@ other tools), ``orchestrator`` (scene loading, masters, studies, SSP, reliabilit
 from __future__ import annotations
 
 import os
+import sys
 from pathlib import Path
 
 import pytest
+
+# Every worker imports the project and the test modules, and the tests start many Python
+# processes that import the project again: with bytecode caches switched off in the
+# environment (PYTHONDONTWRITEBYTECODE), each compiled every source again and pytest
+# rewrote every test module again (collection 12.8 s a process, 4.2 s with the caches).
+# The caches go to __pycache__, as Python writes them by default.
+sys.dont_write_bytecode = False
 
 PROJECT_DIR = Path(__file__).resolve().parent.parent
 SCENARIOS = PROJECT_DIR / "scenarios"
