@@ -20,7 +20,6 @@ Instance names come from ``[report.options]`` (defaults "train" and "verge").
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -38,6 +37,7 @@ from orchestrator.scenes.family import Outcome, Quantity, Reference, quantity
 from orchestrator.scenes.m739.report import (
     _parameter,
     _why_not_armed,
+    arming_model,
     crossing_time,
     escapement_arguments,
     escapement_plot,
@@ -147,10 +147,4 @@ def plot(scene: Scene, header: list[str], data: np.ndarray, path: Path) -> None:
 def monolithic_model(scene: Scene) -> Callable[[float], Outcome]:
     """The monolithic model with the scene's physics (as the reference runs it), as a
     function of its tolerance: its turns to arm (NaN: it did not arm)."""
-    kwargs = monolithic_arguments(scene)
-
-    def run(tolerance: float) -> Outcome:
-        result = run_clock_train(tolerance=tolerance, **kwargs)
-        return Outcome(result.turns if result.armed else math.nan, result.reason)
-
-    return run
+    return arming_model(run_clock_train, monolithic_arguments(scene))

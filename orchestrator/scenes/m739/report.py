@@ -425,10 +425,15 @@ def _overview(
 def monolithic_model(scene: Scene) -> Callable[[float], Outcome]:
     """The monolithic model with the scene's physics (as the reference runs it), as a
     function of its tolerance: its turns to arm (NaN: it did not arm)."""
-    kwargs = monolithic_arguments(scene)
+    return arming_model(run_m739, monolithic_arguments(scene))
+
+
+def arming_model(model: Callable[..., Any], kwargs: dict[str, Any]) -> Callable[[float], Outcome]:
+    """``model(tolerance=..., **kwargs)`` (an S&A's monolithic run) as a function of its
+    tolerance: its turns to arm (NaN: it did not arm)."""
 
     def run(tolerance: float) -> Outcome:
-        result = run_m739(tolerance=tolerance, **kwargs)
+        result = model(tolerance=tolerance, **kwargs)
         return Outcome(result.turns if result.armed else math.nan, result.reason)
 
     return run
