@@ -189,7 +189,7 @@ def test_the_m739_plot_names_the_fmus_regimes(
     from orchestrator.scenes.m739 import report
 
     figures = []
-    monkeypatch.setattr(report, "save_figure", lambda fig, path, title=None: figures.append(fig))
+    monkeypatch.setattr(report, "save_figure", lambda fig, path, **_: figures.append(fig))
     scene = load_scene(SCENARIOS / "m739.toml", {"scene.stop": "3 ms"})
     run_scene(scene, tmp_path, show_progress=False, compare_reference=False)
     (fig,) = figures

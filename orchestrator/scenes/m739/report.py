@@ -230,7 +230,6 @@ def escapement_plot(
     armed).  ``extra(axes, ms, col)`` draws on further detail panels (as many as its
     ``panels`` attribute says)."""
     plt = pyplot()
-    from matplotlib.layout_engine import PlaceHolderLayoutEngine  # a plot's import only
 
     train, verge = instance_names(scene)
     col = {name: data[:, i] for i, name in enumerate(header)}
@@ -245,7 +244,6 @@ def escapement_plot(
     # times over to place it: most of the plot's cost): legends stand right of the axes.
     width, height = 11.0, 15.0 + 1.8 * panels
     fig = plt.figure(figsize=(width, height))
-    fig.set_layout_engine(PlaceHolderLayoutEngine(True, True))  # laid out here: no tight layout
     top_height = 6.4  # the whole run, whatever the detail panels below
     top, bottom = fig.subfigures(2, 1, height_ratios=(top_height, height - top_height))
     verge_colours = regime_colours(regime_names(scene, verge))
@@ -301,7 +299,7 @@ def escapement_plot(
     axes[-1].set_xlabel("time [ms]")
     axes[-1].set_xlim(1e3 * t[0], 1e3 * detail_end)
     bottom.align_ylabels(axes)
-    save_figure(fig, path)
+    save_figure(fig, path, tight=False)  # laid out here
 
 
 def _margins(
