@@ -326,27 +326,23 @@ class ComponentSlave(Fmi2Slave):
             )
 
     def get_real(self, vrs: list[int]) -> list[float]:
-        key = tuple(vrs)
-        read = self._readers["Real"].get(key)
-        if read is None:
-            if not self._readable["Real"].issuperset(vrs):
-                self._bad_reference("fmi2GetReal", "Real", vrs, self._readable["Real"])
-                return [0.0] * len(vrs)
-            read = self._reader("Real", key, float)
-        if (self._outputs_stale or self._initializing) and not self._refresh("fmi2GetReal"):
-            return [0.0] * len(vrs)
-        return read(self.model)
+        return self._get("Real", vrs, float, 0.0, "fmi2GetReal")
 
     def get_integer(self, vrs: list[int]) -> list[int]:
+        return self._get("Integer", vrs, int, 0, "fmi2GetInteger")
+
+    def _get(self, kind: str, vrs: list[int], cast: type, zero: Any, function: str) -> list:
+        """The values of ``vrs`` (of ``kind``), outputs brought up to date first; zeros
+        where the call is refused."""
         key = tuple(vrs)
-        read = self._readers["Integer"].get(key)
+        read = self._readers[kind].get(key)
         if read is None:
-            if not self._readable["Integer"].issuperset(vrs):
-                self._bad_reference("fmi2GetInteger", "Integer", vrs, self._readable["Integer"])
-                return [0] * len(vrs)
-            read = self._reader("Integer", key, int)
-        if (self._outputs_stale or self._initializing) and not self._refresh("fmi2GetInteger"):
-            return [0] * len(vrs)
+            if not self._readable[kind].issuperset(vrs):
+                self._bad_reference(function, kind, vrs, self._readable[kind])
+                return [zero] * len(vrs)
+            read = self._reader(kind, key, cast)
+        if (self._outputs_stale or self._initializing) and not self._refresh(function):
+            return [zero] * len(vrs)
         return read(self.model)
 
     def _reader(self, kind: str, vrs: tuple[int, ...], cast: type) -> Any:

@@ -21,10 +21,10 @@ class RestoreCheck:
     def __init__(self, inst: Any) -> None:
         outputs = [v for v in inst.model_description.modelVariables if v.causality == "output"]
         self.real_names = [v.name for v in outputs if v.type == "Real"]
-        int_names = [v.name for v in outputs if v.type in ("Integer", "Enumeration")]
-        self.int_names = int_names
-        self._reals = inst.getter(inst.refs(self.real_names)) if self.real_names else None
-        self._ints = inst.getter(inst.refs(int_names), integer=True) if int_names else None
+        self.int_names = [v.name for v in outputs if v.type in ("Integer", "Enumeration")]
+        reals, ints = self.real_names, self.int_names
+        self._reals = inst.getter(inst.refs(reals)) if reals else None
+        self._ints = inst.getter(inst.refs(ints), integer=True) if ints else None
         self.at_save: dict[int, tuple[list[float], list[int]]] = {}
         self.failure: str | None = None  # what differed at the first restore that failed
 
