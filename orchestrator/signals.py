@@ -28,7 +28,7 @@ from typing import Any
 
 from orchestrator.errors import ScenarioError
 from orchestrator.regular_files import CSV_LIMIT, NotARegularFile, read_regular
-from orchestrator.units import UREG, pint_unit
+from orchestrator.units import pint_unit, ureg
 
 INTERPOLATIONS = ("linear", "hold")
 OUTSIDE = ("hold", "error")
@@ -464,8 +464,8 @@ def fmpy_header(cells: list[str]) -> bool:
 def _affine(unit: str, target: str, path: Path, key: str, column: str) -> Callable[[float], float]:
     """Conversion of one column's numbers to the SI unit (offsets such as degC kept)."""
     try:
-        a = float(UREG.Quantity(0.0, unit).to(pint_unit(target)).magnitude)
-        b = float(UREG.Quantity(1.0, unit).to(pint_unit(target)).magnitude)
+        a = float(ureg().Quantity(0.0, unit).to(pint_unit(target)).magnitude)
+        b = float(ureg().Quantity(1.0, unit).to(pint_unit(target)).magnitude)
     except Exception as exc:  # pint raises several unrelated types
         raise ScenarioError(
             path, key, f"line 1: column {column!r} in [{unit}] is not in {target} ({exc})"

@@ -1,0 +1,63 @@
+"""Small results kept beside the FMUs between processes (``<FMU cache>/memo/<name>.json``):
+what a later process would otherwise work out again from the same inputs, such as the
+imports of a source file or the conversion of a quantity's text.
+
+A memo is a JSON object of text keys; its name says what its entries depend on besides
+their keys (a hash of the code that made them), so a change of that code starts an empty
+memo.  A memo that cannot be read (half-written by a process that died) is passed over and
+its entries worked out again; one that cannot be written is not kept.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+from pathlib import Path
+from typing import Any
+
+#: a memo grown past this many entries (sweeps of --set values) starts again
+MAX_ENTRIES = 20_000
+
+
+class DiskMemo:
+    """One memo file, read at the first lookup, written at once after each new entry
+    (a process may end any time after it)."""
+
+    def __init__(self, name: str) -> None:
+        self.name = name
+        self._entries: dict[str, Any] | None = None
+
+    def path(self) -> Path:
+        from fmus.kernel_build import default_cache_dir
+
+        return default_cache_dir() / "memo" / f"{self.name}.json"
+
+    def _loaded(self) -> dict[str, Any]:
+        if self._entries is None:
+            try:
+                entries = json.loads(self.path().read_text())
+            except (OSError, ValueError):
+                entries = {}
+            self._entries = entries if isinstance(entries, dict) else {}
+        return self._entries
+
+    def get(self, key: str) -> Any:
+        """The entry of ``key``, or None."""
+        return self._loaded().get(key)
+
+    def put(self, key: str, value: Any) -> None:
+        entries = self._loaded()
+        if len(entries) >= MAX_ENTRIES:
+            entries.clear()
+        entries[key] = value
+        path = self.path()
+        try:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            # a file of its own, then an atomic rename: readers never see half a memo
+            fd, partial = tempfile.mkstemp(prefix=f".{self.name}-", suffix=".part", dir=path.parent)
+            with os.fdopen(fd, "w") as f:
+                json.dump(entries, f)
+            os.replace(partial, path)
+        except OSError:
+            pass  # an unwritable cache: worked out again next time

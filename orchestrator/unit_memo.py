@@ -1,0 +1,50 @@
+"""The conversions ``orchestrator.units.to_si`` has made, kept beside the FMUs
+(``fmus.disk_memo``) so that a later process converts the same texts without importing
+pint.  The memo's name hashes the conversion code and pint's installation: an edit of
+either starts an empty memo.  Numbers are stored by their ``repr``, which reads back to the
+same bits."""
+
+from __future__ import annotations
+
+import hashlib
+import importlib.util
+from functools import cache
+from pathlib import Path
+
+from fmus.disk_memo import DiskMemo
+
+_CODE = (
+    Path(__file__).resolve().with_name("units.py"),
+    Path(__file__).resolve().parent.parent / "components" / "units.py",
+)
+
+
+@cache
+def _memo() -> DiskMemo | None:
+    """This code's and this pint's memo; None where pint is not installed."""
+    spec = importlib.util.find_spec("pint")  # located, not imported
+    if spec is None or spec.origin is None:
+        return None
+    h = hashlib.sha256()
+    for path in _CODE:
+        h.update(path.read_bytes())
+    origin = Path(spec.origin)
+    h.update(f"{origin}:{origin.stat().st_mtime_ns}".encode())
+    return DiskMemo(f"units-{h.hexdigest()[:16]}")
+
+
+def _key(value: str, unit: str, exact: bool) -> str:
+    return f"{int(exact)}\x1f{unit}\x1f{value}"
+
+
+def recall(value: str, unit: str, exact: bool) -> float | None:
+    """The float ``value`` converted to ``unit`` earlier, or None."""
+    memo = _memo()
+    found = None if memo is None else memo.get(_key(value, unit, exact))
+    return found if isinstance(found, float) else None
+
+
+def remember(value: str, unit: str, exact: bool, converted: float) -> None:
+    memo = _memo()
+    if memo is not None:
+        memo.put(_key(value, unit, exact), float(converted))
