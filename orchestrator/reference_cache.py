@@ -58,6 +58,20 @@ def cached_reference(
 
 def reference_key(scene: Scene) -> str:
     """A hash of what the scene's reference depends on."""
+    content = {
+        "format": _FORMAT,
+        "python": sys.version,
+        "reference": scene.reference,
+        **scene_content(scene),
+        "code": code_hash(str(scene.reference)),
+    }
+    text = json.dumps(content, sort_keys=True)
+    return hashlib.sha256(text.encode()).hexdigest()[:32]
+
+
+def scene_content(scene: Scene) -> dict[str, Any]:
+    """What of a scene its physics depends on, as JSON: its FMU instances (component or
+    file hash, parameters as run), report options, start, stop and stop condition."""
     fmus = {}
     for name, spec in sorted(scene.fmus.items()):
         fmus[name] = {
@@ -66,20 +80,13 @@ def reference_key(scene: Scene) -> str:
             "file": None if spec.component else _file_hash(Path(spec.path)),
             "parameters": {k: repr(v) for k, v in sorted(spec.parameters.items())},
         }
-    cond = scene.stop_when
-    content = {
-        "format": _FORMAT,
-        "python": sys.version,
-        "reference": scene.reference,
+    return {
         "fmus": fmus,
         "options": repr(sorted(scene.report_options.items())),
         "start": repr(scene.start),
         "stop": repr(scene.stop),
-        "stop_when": repr(cond),
-        "code": code_hash(str(scene.reference)),
+        "stop_when": repr(scene.stop_when),
     }
-    text = json.dumps(content, sort_keys=True)
-    return hashlib.sha256(text.encode()).hexdigest()[:32]
 
 
 @cache

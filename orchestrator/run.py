@@ -35,6 +35,7 @@ from orchestrator.masters.macro_step import Master
 from orchestrator.masters.registry import algorithm
 from orchestrator.observers import EnergyBalance, RegimeLog, StepCounter, TimeSeries
 from orchestrator.output_lock import OutputLock
+from orchestrator.plot_cache import cached_plot
 from orchestrator.plotting import pyplot
 from orchestrator.progress import ProgressBar
 from orchestrator.provenance import source_commit
@@ -90,8 +91,8 @@ def run_scene(
 
     The directory is locked for the run (``OutputInUseError`` if another run holds it).
     SIGINT/SIGTERM stop the run at the next step boundary with status "interrupted".
-    ``reference_cache``: read the reference from, and keep it in, the FMU cache directory
-    (``orchestrator.reference_cache``).
+    ``reference_cache``: read the reference and the plot from, and keep them in, the FMU
+    cache directory (``orchestrator.reference_cache``, ``orchestrator.plot_cache``).
     """
     out = Path(output_dir) if output_dir else scene.output_dir
     options = _Options(compare_reference, plots, cache_dir, reference_cache, Phases())
@@ -335,10 +336,21 @@ def _analyse(
     plotted = scene.family in PLOTS and options.plots and len(data) > 1
     if scene.family and status == "completed" and plotted:
         with _noted(notes, f"plot of {scene.family!r}", header):
-            with phases.timed("plot: import matplotlib"):
-                pyplot()  # once a process: told apart from the drawing
-            with phases.timed("plot: draw and write the PNG"):
-                PLOTS[scene.family](scene, header, data, out / f"{scene.name}.png")
+            png = out / f"{scene.name}.png"
+
+            def draw() -> None:
+                with phases.timed("plot: import matplotlib"):
+                    pyplot()  # once a process: told apart from the drawing
+                with phases.timed("plot: draw and write the PNG"):
+                    PLOTS[scene.family](scene, header, data, png)
+
+            if options.reference_cache:
+                start = time.perf_counter()
+                cache_dir = options.cache_dir or default_cache_dir()
+                if cached_plot(scene, header, data, png, draw, cache_dir):
+                    phases["plot (from the cache)"] = time.perf_counter() - start
+            else:
+                draw()
     accuracy: dict[str, float] = {}
     ref = None
     if scene.reference and status == "completed" and options.compare_reference:
