@@ -532,6 +532,12 @@ def speed() -> None:
     print("all times measured in this run, on this machine")
 
 
+def _study() -> None:
+    from orchestrator.studies.study_speed import print_study_speed
+
+    print_study_speed()
+
+
 def _supervision() -> None:
     from orchestrator.studies.supervision_cost import print_supervision_cost
 
@@ -567,4 +573,5 @@ BENCHMARKS: dict[str, Callable[[], None]] = {
     "speed": speed,
     "supervision": _supervision,
     "animate": animate,
+    "study": _study,
 }
