@@ -33,6 +33,7 @@ import pythonfmu
 from pythonfmu.builder import FmuBuilder
 
 from components.base import Component
+from fmus.bytecode import add_bytecode
 from fmus.description import complete_description
 from fmus.documentation import render_documentation
 from fmus.host_loader import LOADER_SOURCE, loader_binary, loader_plan, pack_loader
@@ -60,6 +61,7 @@ BUILD_CODE = (
     FMUS_DIR / "host_loader.py",
     FMUS_DIR / "kernel_build.py",
     FMUS_DIR / "input_derivatives.py",
+    FMUS_DIR / "bytecode.py",
     LOADER_SOURCE,
 )
 #: the date of every entry of an FMU archive (the earliest a zip file can hold)
@@ -198,6 +200,7 @@ def _finish(
     members["modelDescription.xml"] = xml
     if loader is not None:
         pack_loader(members, name, loader)
+    add_bytecode(members)
     with zipfile.ZipFile(fmu, "w", zipfile.ZIP_DEFLATED) as z:
         for n in sorted(members):
             info = zipfile.ZipInfo(n, ZIP_DATE)
