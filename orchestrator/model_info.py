@@ -24,6 +24,7 @@ from fmpy import read_model_description
 
 from components.base import ROLE_CAUSALITY, ROLES_OF, Role
 from fmus.description import TOOL
+from orchestrator import model_info_memo
 from orchestrator.units import pint_unit
 
 #: FMI types read and written with fmi2GetInteger / fmi2SetInteger
@@ -126,8 +127,18 @@ def base_of_unit_name(unit: str) -> tuple[tuple[tuple[str, int], ...], float] | 
 
 @cache
 def model_info(path: Path) -> ModelInfo:
-    """Read an FMU file (cached per path: built FMUs are named by their content hash)."""
+    """Read an FMU file (cached per path: built FMUs are named by their content hash; and
+    between processes by the file's hash, ``orchestrator.model_info_memo``)."""
     path = Path(path)
+    known = model_info_memo.recall(path)
+    if known is not None:
+        return known
+    info = _read_model_info(path)
+    model_info_memo.remember(path, info)
+    return info
+
+
+def _read_model_info(path: Path) -> ModelInfo:
     _check_description(path, _description(path))
     try:
         md = read_model_description(str(path), validate=False)
