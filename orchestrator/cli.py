@@ -194,7 +194,9 @@ def main(argv: list[str] | None = None) -> int:
     p.set_defaults(handler=_stability)
 
     p = sub.add_parser("bench", help="run a benchmark (prints ratios against its baseline)")
-    p.add_argument("name", choices=["overhead", "m739", "speed", "supervision", "animate", "study"])
+    p.add_argument(
+        "name", choices=["overhead", "m739", "speed", "supervision", "animate", "study", "answer"]
+    )
     p.set_defaults(handler=_bench)
 
     p = sub.add_parser(

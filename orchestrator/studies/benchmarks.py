@@ -532,6 +532,12 @@ def speed() -> None:
     print("all times measured in this run, on this machine")
 
 
+def _answer() -> None:
+    from orchestrator.studies.answer_time import print_answer_time
+
+    print_answer_time()
+
+
 def _study() -> None:
     from orchestrator.studies.study_speed import print_study_speed
 
@@ -574,4 +580,5 @@ BENCHMARKS: dict[str, Callable[[], None]] = {
     "supervision": _supervision,
     "animate": animate,
     "study": _study,
+    "answer": _answer,
 }
