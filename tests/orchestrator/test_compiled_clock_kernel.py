@@ -1,0 +1,180 @@
+"""The clock-train kernel (components/clock_train_kernel.pyx) gives the same bits as the
+Python code: the clock-train scene, its monolithic reference and the train's model under
+each wrapper the train component integrates it in are run with each path, in processes of
+their own (the kernels are bound at import), and compared byte for byte."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import zipfile
+from pathlib import Path
+
+import pytest
+
+from components.kernels import pure_python
+from fmus.build import build_fmu
+from fmus.kernel_build import kernel_plan
+
+PROJECT = Path(__file__).resolve().parents[2]
+needs_kernels = pytest.mark.skipif(
+    kernel_plan().compiler is None or pure_python(),
+    reason="no Cython or C compiler, or MECHCOSIM_PURE_PYTHON set: no compiled kernels here",
+)
+
+# One process per path: argv = scene stop ("-": no scene run), output folder, then the
+# monolithic runs as JSON keyword dictionaries.
+_RUN = """
+import hashlib, json, sys
+from pathlib import Path
+from components import event_integration as ei
+from components.clock_gear_train import ClockTrainPhysics, _ClockModel
+from components.early_return import UntilFirstEvent
+from components.kernels import load_kernel
+from components.m739_data import M739, rpm_to_rad_s
+from components.train_component import STATE_SCALES, RampedLoad
+from orchestrator.run import run_scene
+from orchestrator.scenario import load_scene
+from orchestrator.scenes.clock_train.monolithic import run_clock_train
+
+def digest(r):
+    h = hashlib.sha256(repr((r.armed, r.reason, r.turns, r.f23_max, r.f12_max, r.ff23_max,
+                             r.ff12_max, r.pn_max, r.impacts, r.events, r.train_log,
+                             r.handovers)).encode())
+    for v in r.series.values():
+        h.update(v.tobytes())
+    return h.hexdigest()
+
+out = {"compiled": load_kernel("clock_train_kernel") is not None}
+out["monolithic"] = [digest(run_clock_train(**json.loads(a))) for a in sys.argv[3:]]
+
+# The train's model alone, under each wrapper, from rest against a held escapement torque:
+# the state, the counts, the memos the friction branches read and the force peaks.
+def model(loss_model, t_esc):
+    p = ClockTrainPhysics(omega=rpm_to_rad_s(M739.rpm), loss_model=loss_model)
+    m = _ClockModel(p)
+    m.t_esc = t_esc
+    m.try_unstick(0.0)
+    return p, m
+
+out["model"] = []
+for loss_model in (0, 1, 2):
+    for wrap in ("bare", "ramped", "first event", "budget"):
+        p, m = model(loss_model, -2e-4)
+        control = ei.IntegrationStepControl(1e-8, STATE_SCALES, 1e-4,
+                                            5 if wrap == "budget" else None)
+        y = [0.0, 0.0, 0.0]
+        wrapped = m
+        if wrap == "ramped":
+            wrapped, y = RampedLoad(m, 1e-2), [*y, m.t_esc]
+            control = ei.IntegrationStepControl(1e-8, (*STATE_SCALES, 1.0), 1e-4)
+        elif wrap == "first event":
+            wrapped = UntilFirstEvent(m, 0.0)
+        try:
+            done = [tuple(ei.advance(wrapped, y, 4e-3, control))]
+        except ei.StepBudgetSpent as exc:
+            done = [str(exc)]
+        out["model"].append(repr((done, p.memos(), p.evaluate_phi, m.peaks, m.stuck,
+                                  p.mode_key(), p.handovers, m.t_esc)))
+
+if sys.argv[1] != "-":
+    overrides = {} if sys.argv[1] == "full" else {"scene.stop": sys.argv[1]}
+    scene = load_scene(Path("scenarios/clock_train_sa.toml"), overrides)
+    run_scene(scene, output_dir=Path(sys.argv[2]), show_progress=False,
+              compare_reference=False, plots=False)
+print(json.dumps(out))
+"""
+
+#: the monolithic runs compared: the scene's physics, then each loss model and no friction
+SHORT_MONOLITHIC = (
+    {"t_stop": 0.01},
+    {"t_stop": 0.01, "loss_model": 0},
+    {"t_stop": 0.01, "loss_model": 2},
+    {"t_stop": 0.005, "mu": 0.0},
+    {"t_stop": 0.01, "tolerance": 1e-6},
+)
+
+
+def _run(pure: bool, stop: str, out: Path, *monolithic: dict) -> dict:
+    """The outputs of one path in a process of its own: the compiled flag, the monolithic
+    digests, the model runs and the scene's CSVs (stop '-': no scene run)."""
+    env = {k: v for k, v in os.environ.items() if k != "MECHCOSIM_PURE_PYTHON"}
+    env["PYTHONPATH"] = str(PROJECT)
+    if pure:
+        env["MECHCOSIM_PURE_PYTHON"] = "1"
+    argv = [stop, str(out), *(json.dumps(kw) for kw in monolithic)]
+    run = subprocess.run(
+        [sys.executable, "-c", _RUN, *argv],
+        env=env,
+        capture_output=True,
+        text=True,
+        cwd=PROJECT,
+        check=False,
+    )
+    assert run.returncode == 0, run.stderr[-2000:]
+    result = json.loads(run.stdout.strip().splitlines()[-1])
+    if stop != "-":
+        result["csv"] = {f: (out / f).read_bytes() for f in ("timeseries.csv", "events.csv")}
+    return result
+
+
+@pytest.fixture(scope="module")
+def short_runs(tmp_path_factory: pytest.TempPathFactory) -> tuple[dict, dict]:
+    """Both paths on the first 10 ms of clock_train_sa.toml, the short monolithic runs and
+    the model runs."""
+    folder = tmp_path_factory.mktemp("clock_kernel")
+    compiled = _run(False, "10 ms", folder / "compiled", *SHORT_MONOLITHIC)
+    python = _run(True, "10 ms", folder / "python", *SHORT_MONOLITHIC)
+    return compiled, python
+
+
+@needs_kernels
+def test_the_clock_train_fmu_ships_the_kernel() -> None:
+    with zipfile.ZipFile(build_fmu("ClockGearTrain")) as z:
+        assert any(n.endswith("/components/clock_train_kernel.so") for n in z.namelist())
+
+
+@needs_kernels
+def test_both_paths_agree_on_a_short_clock_train_run(short_runs: tuple[dict, dict]) -> None:
+    compiled, python = short_runs
+    assert (compiled["compiled"], python["compiled"]) == (True, False)
+    assert compiled["csv"] == python["csv"]
+    events = compiled["csv"]["events.csv"].decode()
+    assert events.count("\n") > 10  # the run did move: impacts and tooth handovers
+
+
+@needs_kernels
+def test_both_paths_agree_on_the_short_monolithic_runs(short_runs: tuple[dict, dict]) -> None:
+    compiled, python = short_runs
+    assert len(compiled["monolithic"]) == len(SHORT_MONOLITHIC)
+    assert compiled["monolithic"] == python["monolithic"]
+
+
+@needs_kernels
+def test_both_paths_agree_on_the_train_model_in_every_wrapper(
+    short_runs: tuple[dict, dict],
+) -> None:
+    compiled, python = short_runs
+    assert compiled["model"] == python["model"]
+    # Each loss model: three runs that end and one whose budget of 5 steps is spent.
+    spent = [r for r in compiled["model"] if "spent its budget of 5 internal steps" in r]
+    assert len(spent) == 3 and len(compiled["model"]) == 12
+
+
+@pytest.mark.slow
+@needs_kernels
+def test_both_paths_agree_on_the_clock_train_scene(tmp_path: Path) -> None:
+    compiled = _run(False, "full", tmp_path / "c")
+    assert compiled["csv"] == _run(True, "full", tmp_path / "py")["csv"]
+
+
+@pytest.mark.slow
+@needs_kernels
+def test_both_paths_agree_on_the_clock_train_monolithic_model(tmp_path: Path) -> None:
+    full = ({"t_stop": 0.2}, {"t_stop": 0.2, "loss_model": 2})
+    assert (
+        _run(False, "-", tmp_path, *full)["monolithic"]
+        == (_run(True, "-", tmp_path, *full)["monolithic"])
+    )
