@@ -83,6 +83,7 @@ from .clock_train_design import DESIGN_VARIABLES, body_data, clock_train, train_
 from .clock_train_design import values_of as design_values
 from .clock_train_kinematics import M739_TRAIN, ClockMesh, ClockTrain
 from .design_rules import raise_first
+from .early_return import UntilFirstEvent
 from .escape_wheel import (
     ESCAPE_WHEEL_PORT,
     ESCAPE_WHEEL_VARIABLES,
@@ -91,7 +92,6 @@ from .escape_wheel import (
     WHEEL_INPUTS,
     response_slope_outputs,
 )
-from .early_return import UntilFirstEvent
 from .event_integration import INTEGRATION_VARIABLES, use_compiled_loop
 from .kernels import load_kernel
 from .m739_data import M739, M739Data
