@@ -37,6 +37,10 @@ from components.m739_data import M739, rpm_to_rad_s
 from components.train_component import STATE_SCALES, RampedLoad
 from orchestrator.run import run_scene
 from orchestrator.scenario import load_scene
+from components.verge_escapement import STATE_SCALES as VERGE_SCALES
+from components.verge_escapement import StepBudgetSpent as VergeBudgetSpent
+from components.verge_escapement import VergeConstants, escapement_data
+from orchestrator.scenes.clock_train.monolithic import _ClockMonolithic, arming_phi
 from orchestrator.scenes.clock_train.monolithic import run_clock_train
 
 def digest(r):
@@ -78,6 +82,28 @@ for loss_model in (0, 1, 2):
             done = [str(exc)]
         out["model"].append(repr((done, p.memos(), p.evaluate_phi, m.peaks, m.stuck,
                                   p.mode_key(), p.handovers, m.t_esc)))
+
+# The monolithic model's own loop with the integration's budget (steps), the verge's
+# (indicator evaluations), then neither.
+def start():
+    omega = rpm_to_rad_s(M739.rpm)
+    data = escapement_data(M739.a, pallet_inertia=M739.ip)
+    train = ClockTrainPhysics(omega=omega)
+    k = VergeConstants(data, M739.mu1, M739.mu, omega, M739.e_rest)
+    core = _ClockMonolithic(k, train, data.phi_start, phi_stop=arming_phi(train))
+    return core, core.decide_direction(core._sync_kinematics([0.0] * 5), 0.0, 1)
+
+out["budgets"] = []
+for steps, evaluations in ((7, None), (None, 40), (None, 100_000)):
+    core, y = start()
+    core.budget = evaluations
+    try:
+        control = ei.IntegrationStepControl(1e-9, VERGE_SCALES, max_steps=steps)
+        done = ei.advance(core, y, 2e-3, control)
+        out["budgets"].append(["done", *done[1:], core.budget, repr(done.y),
+                               repr(core.train.memos()), repr(core.__dict__.get("_memo"))])
+    except (ei.StepBudgetSpent, VergeBudgetSpent) as exc:
+        out["budgets"].append([type(exc).__module__, str(exc), core.budget])
 
 if sys.argv[1] != "-":
     overrides = {} if sys.argv[1] == "full" else {"scene.stop": sys.argv[1]}
@@ -161,6 +187,20 @@ def test_both_paths_agree_on_the_train_model_in_every_wrapper(
     # Each loss model: three runs that end and one whose budget of 5 steps is spent.
     spent = [r for r in compiled["model"] if "spent its budget of 5 internal steps" in r]
     assert len(spent) == 3 and len(compiled["model"]) == 12
+
+
+@needs_kernels
+def test_a_spent_step_budget_ends_both_paths_alike(short_runs: tuple[dict, dict]) -> None:
+    compiled, python = short_runs
+    assert compiled["budgets"] == python["budgets"]
+    steps, evaluations, unbounded = compiled["budgets"]
+    # The integration's budget: 7 steps, then the 8th is refused with the step's numbers.
+    assert steps[0] == "components.event_integration"
+    assert steps[1].startswith("spent its budget of 7 internal steps (max_internal_steps)")
+    # The verge's own budget counts indicator evaluations: 40 and the 41st is refused.
+    assert evaluations == ["components.verge_escapement", "internal step budget spent", -1]
+    # Without a budget the 2 ms run ends, past several events, having counted the same.
+    assert unbounded[0] == "done" and unbounded[3] > 5 and 0 < unbounded[7] < 100_000
 
 
 @pytest.mark.slow
