@@ -116,13 +116,21 @@ if sys.argv[1] != "-":
 print(json.dumps(out))
 """
 
-#: the monolithic runs compared: the scene's physics, then each loss model and no friction
+#: the monolithic runs compared: the scene's physics, each loss model, no friction, a looser
+#: tolerance and another train
 SHORT_MONOLITHIC = (
     {"t_stop": 0.006},
     {"t_stop": 0.004, "loss_model": 0},
     {"t_stop": 0.004, "loss_model": 2},
     {"t_stop": 0.003, "mu": 0.0},
     {"t_stop": 0.006, "tolerance": 1e-6},
+    # another geometry: phased cluster, other round offsets, the train started mid-piece
+    {
+        "t_stop": 0.004,
+        "mesh_phase": 0.2,
+        "pivot_loads": False,
+        "design": {"cluster_phasing": 0.1, "gear1_round_offset": 0.12, "pinion3_teeth": 9},
+    },
 )
 
 
