@@ -251,7 +251,9 @@ cdef class _Clock:
     """One ClockTrainPhysics as C values: its constants and its mode."""
 
     cdef MeshGeometry g1, g2
-    cdef double psi0, kappa2, px[2], py[2]
+    cdef double psi0, kappa2
+    cdef double px[2]
+    cdef double py[2]
     cdef double i1, i2, i3, a35, phi1c, theta1_0, mu
     cdef double pivot[3]
     cdef double rho[2][2]
@@ -860,7 +862,8 @@ cdef class _Loop:
                 n_events += fired
                 recent.append(first)
                 if n_events > max_events:
-                    which = ", ".join(str(i) for i in sorted(set(recent[max(0, len(recent) - 20):])))
+                    last = recent[max(0, len(recent) - 20):]
+                    which = ", ".join(str(i) for i in sorted(set(last)))
                     raise COMPONENT_ERROR(
                         f"too many events inside one step (chattering: indicators {which}, "
                         f"{t:.6g} s into the step)"
