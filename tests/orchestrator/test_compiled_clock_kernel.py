@@ -86,6 +86,37 @@ for loss_model in (0, 1, 2):
         out["model"].append(repr((done, p.memos(), p.evaluate_phi, m.peaks, m.stuck,
                                   p.mode_key(), p.handovers, m.t_esc)))
 
+# The physics' methods one by one: on a grid of positions, each direction, normal-force
+# signs and loss model, on the piece entered there and on pieces beyond their reach (no
+# contact): the values, or the exception and its message.
+def outcome(f, *args):
+    try:
+        return repr(f(*args))
+    except (ArithmeticError, ValueError) as exc:
+        return repr(exc)
+
+twins = hashlib.sha256()
+out["twin errors"] = 0
+for loss_model in (0, 1, 2):
+    p = ClockTrainPhysics(omega=rpm_to_rad_s(M739.rpm), loss_model=loss_model)
+    for j in range(25):
+        phi = -0.9 + 0.075 * j
+        for direction in (1, -1):
+            p.set_mode(phi, direction)
+            entered = p.pieces
+            for shift in (0, 2):
+                p.pieces = tuple((k + shift, ph, sg) for k, ph, sg in entered)
+                for sigma in ((1, 1), (-1, 1), (1, -1)):
+                    p.sigma = sigma
+                    rows = [outcome(p.evaluate, phi), outcome(p.response, phi, 300.0 * j - 50.0),
+                            outcome(p.forces, phi, 120.0, 3.0e4 - 2.0e3 * j),
+                            outcome(p.power_terms, phi), outcome(p.piece_distances, phi)]
+                    if not rows[0].startswith("ValueError"):
+                        rows.append(outcome(p.point_efficiency, 1, p.evaluate(phi)[9]))
+                    out["twin errors"] += sum(r.startswith("ValueError") for r in rows)
+                    twins.update(repr(rows).encode())
+out["twins"] = twins.hexdigest()
+
 # The monolithic model's own loop with the integration's budget (steps), the verge's
 # (indicator evaluations), then neither.
 def start():
@@ -221,6 +252,14 @@ def test_both_paths_agree_on_the_train_model_in_every_wrapper(
     # event it ends at one.
     assert compiled["events"] == python["events"]
     assert [n > 20 for n in compiled["events"]] == [True, True, False] * 3
+
+
+@needs_kernels
+def test_both_paths_agree_on_the_physics_methods(short_runs: tuple[dict, dict]) -> None:
+    compiled, python = short_runs
+    assert compiled["twins"] == python["twins"]
+    # Pieces beyond their reach (two pitches on) fail alike: no contact.
+    assert compiled["twin errors"] == python["twin errors"] > 100
 
 
 @needs_kernels
