@@ -139,11 +139,17 @@ for steps, evaluations in ((7, None), (None, 40), (None, 100_000)):
     except (ei.StepBudgetSpent, VergeBudgetSpent) as exc:
         out["budgets"].append([type(exc).__module__, str(exc), core.budget])
 
-if sys.argv[1] != "-":
-    overrides = {} if sys.argv[1] == "full" else {"scene.stop": sys.argv[1]}
+def run(overrides, folder):
     scene = load_scene(Path("scenarios/clock_train_sa.toml"), overrides)
-    run_scene(scene, output_dir=Path(sys.argv[2]), show_progress=False,
+    run_scene(scene, output_dir=Path(folder), show_progress=False,
               compare_reference=False, plots=False)
+
+if sys.argv[1] == "full":
+    run({}, sys.argv[2])
+elif sys.argv[1] != "-":  # and the cycle efficiencies' train, undamped by the verge
+    run({"scene.stop": sys.argv[1]}, sys.argv[2])
+    run({"scene.stop": "4 ms", "fmus.train.parameters.loss_model": 2,
+         "fmus.verge.parameters.e_rest": 0.3}, Path(sys.argv[2]) / "cycle")
 print(json.dumps(out))
 """
 
@@ -188,7 +194,10 @@ def _run(pure: bool, stop: str, out: Path, *monolithic: dict) -> dict:
         printed = _here(argv)
     result = json.loads(printed.strip().splitlines()[-1])
     if stop != "-":
-        result["csv"] = {f: (out / f).read_bytes() for f in ("timeseries.csv", "events.csv")}
+        files = ("timeseries.csv", "events.csv")
+        result["csv"] = {f: (out / f).read_bytes() for f in files}
+        if stop != "full":
+            result["cycle csv"] = {f: (out / "cycle" / f).read_bytes() for f in files}
     return result
 
 
@@ -230,6 +239,8 @@ def test_both_paths_agree_on_a_short_clock_train_run(short_runs: tuple[dict, dic
     assert compiled["csv"] == python["csv"]
     events = compiled["csv"]["events.csv"].decode()
     assert events.count("\n") > 10  # the run did move: impacts and tooth handovers
+    assert compiled["cycle csv"] == python["cycle csv"]
+    assert compiled["cycle csv"]["timeseries.csv"].count(b"\n") > 10
 
 
 @needs_kernels
