@@ -83,6 +83,7 @@ from .clock_train_design import DESIGN_VARIABLES, body_data, clock_train, train_
 from .clock_train_design import values_of as design_values
 from .clock_train_kinematics import M739_TRAIN, ClockMesh, ClockTrain
 from .design_rules import raise_first
+from .early_return import UntilFirstEvent
 from .escape_wheel import (
     ESCAPE_WHEEL_PORT,
     ESCAPE_WHEEL_VARIABLES,
@@ -91,10 +92,11 @@ from .escape_wheel import (
     WHEEL_INPUTS,
     response_slope_outputs,
 )
-from .event_integration import INTEGRATION_VARIABLES
+from .event_integration import INTEGRATION_VARIABLES, use_compiled_loop
+from .kernels import load_kernel
 from .m739_data import M739, M739Data
 from .sanda2v_deck import CHECK_DESIGN
-from .train_component import TrainComponent, TrainLoadModel
+from .train_component import RampedLoad, TrainComponent, TrainLoadModel
 
 LOSS_NONE = 0
 LOSS_POINT = 1
@@ -686,3 +688,20 @@ class ClockGearTrain(TrainComponent):
         self.stored_energy = 0.5 * j0 * w * w
         self.external_work = p.a35 * (math.cos(rotor) - self._cos0)
         self.dissipated_work = wd
+
+
+_KERNEL = load_kernel("clock_train_kernel")
+if _KERNEL is not None:  # the compiled twins (components.kernels): the same results
+    ClockTrainPhysics.evaluate = _KERNEL.evaluate  # type: ignore[method-assign]
+    ClockTrainPhysics.moments = _KERNEL.moments  # type: ignore[method-assign]
+    ClockTrainPhysics.response = _KERNEL.response  # type: ignore[method-assign]
+    ClockTrainPhysics.power_terms = _KERNEL.power_terms  # type: ignore[method-assign]
+    ClockTrainPhysics.forces = _KERNEL.forces  # type: ignore[method-assign]
+    ClockTrainPhysics.piece_distances = _KERNEL.piece_distances  # type: ignore[method-assign]
+    _KERNEL.use_classes(
+        physics=ClockTrainPhysics,
+        model=_ClockModel,
+        ramped_load=RampedLoad,
+        until_first_event=UntilFirstEvent,
+    )
+    use_compiled_loop(_KERNEL)  # the loop between events in C for the clock train's model

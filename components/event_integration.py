@@ -18,6 +18,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
+from types import ModuleType
 from typing import NamedTuple, Protocol
 
 from .base import ComponentError, Variable
@@ -399,8 +400,8 @@ def advance(
     before the mode changes: ``state_at(t)`` is the state at any t in [t0, t1] (offsets
     from the start), e.g. for output at fixed times without shortening the steps.
     """
-    if _COMPILED is not None:  # the same loop in C, for the models it knows (else None)
-        done = _COMPILED(model, y, h_total, control, h_try, tol_t, max_events, observe)
+    for compiled in _COMPILED:  # the same loop in C, for the models it knows (else None)
+        done = compiled(model, y, h_total, control, h_try, tol_t, max_events, observe)
         if done is not None:
             return Advanced(*done)
     deriv = model.deriv
@@ -500,11 +501,21 @@ def advance(
     return Advanced(y, t_first, t_event, n_events, h_next, steps, rejected)
 
 
-_COMPILED: Callable[..., tuple | None] | None = None
+#: the compiled loops (components.kernels), tried in turn: each returns None for a model it
+#: does not know
+_COMPILED: list[Callable[..., tuple | None]] = []
+
+
+def use_compiled_loop(kernel: ModuleType) -> None:
+    """Let a kernel's ``advance`` run the models it knows (it is given the helpers its
+    loop calls back)."""
+    kernel.use_integration(ComponentError, StepBudgetSpent, _fire_at_instant, _first_step)
+    _COMPILED.append(kernel.advance)
+
+
 _KERNEL = load_kernel("m739_kernel")
 if _KERNEL is not None:  # the compiled twins (components.kernels): the same results
     _KERNEL.use_step_type(_Step, _dp5_step)
-    _KERNEL.use_integration(ComponentError, StepBudgetSpent, _fire_at_instant, _first_step)
-    _COMPILED = _KERNEL.advance
+    use_compiled_loop(_KERNEL)
     _dp5_step = _KERNEL.dp5_step
     dense_state = _KERNEL.dense_state

@@ -443,23 +443,39 @@ def _cpu_time(fn: Callable[[], object]) -> float:
     return time.process_time() - t0
 
 
-def kernel_timings(tolerance: float = 1e-6, repeats: int = 3) -> dict[str, object]:
-    """Process times of the M739 scene as written (no reference) and of its monolithic
-    model at ``tolerance``, run in turn ``repeats`` times after one untimed run: with the
-    compiled kernels or without, as this process loaded them (``components.kernels``)."""
+#: The scenes whose compiled kernels ``speed`` times: (name, scene file, kernel, target of
+#: the co-simulation's speed-up).  The M739's co-simulation is mostly its physics; the clock
+#: train's is mostly the master's work between its FMUs, which no kernel compiles.
+KERNEL_SCENES = (
+    ("M739", "m739.toml", "m739_kernel", ">= 3.5"),
+    ("clock-train S&A", "clock_train_sa.toml", "clock_train_kernel", ""),
+)
+
+
+def kernel_timings(
+    tolerance: float = 1e-6,
+    repeats: int = 3,
+    scene_file: str = "m739.toml",
+    kernel: str = "m739_kernel",
+) -> dict[str, object]:
+    """Process times of a scene as written (no reference) and of its monolithic model at
+    ``tolerance``, run in turn ``repeats`` times after one untimed run: with the compiled
+    kernels or without, as this process loaded them (``components.kernels``)."""
     from components.kernels import load_kernel
 
-    scene = load_scene(SCENARIOS / "m739.toml", {})
+    scene = load_scene(SCENARIOS / scene_file, {})
     _, monolithic = monolithic_model(scene)  # the scene's physics, as its reference runs it
     _run(scene, compare_reference=False)  # FMUs extracted and loaded, caches warm
     cosim, mono = [], []
     for _ in range(repeats):
         cosim.append(_cpu_time(partial(_run, scene, compare_reference=False)))
         mono.append(_cpu_time(partial(monolithic, tolerance)))
-    return {"cosim": cosim, "monolithic": mono, "compiled": load_kernel("m739_kernel") is not None}
+    return {"cosim": cosim, "monolithic": mono, "compiled": load_kernel(kernel) is not None}
 
 
-def _kernel_process(pure: bool) -> dict[str, object]:
+def _kernel_process(
+    pure: bool, scene_file: str = "m739.toml", kernel: str = "m739_kernel"
+) -> dict[str, object]:
     """kernel_timings in a process of its own (the kernels are bound when the physics is
     imported, so the two paths need two processes)."""
     env = {k: v for k, v in os.environ.items() if k != "MECHCOSIM_PURE_PYTHON"}
@@ -467,7 +483,7 @@ def _kernel_process(pure: bool) -> dict[str, object]:
         env["MECHCOSIM_PURE_PYTHON"] = "1"
     code = (
         "import json; from orchestrator.studies.benchmarks import kernel_timings; "
-        "print(json.dumps(kernel_timings()))"
+        f"print(json.dumps(kernel_timings(scene_file={scene_file!r}, kernel={kernel!r})))"
     )
     run = subprocess.run(
         [sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True
@@ -476,16 +492,23 @@ def _kernel_process(pure: bool) -> dict[str, object]:
 
 
 def _kernel_rows() -> list[tuple[str, float, str]]:
-    """The compiled kernels' targets: the M739 co-simulation with compiled kernels against
-    the Python fallback, and against the compiled and the Python monolithic model (tolerance 1e-6):
-    medians of process times, the two paths' processes run in turn."""
+    """The compiled kernels' targets, for each of KERNEL_SCENES."""
+    return [row for name, *scene in KERNEL_SCENES for row in _kernel_rows_of(name, *scene)]
+
+
+def _kernel_rows_of(
+    name: str, scene_file: str, kernel: str, speedup: str
+) -> list[tuple[str, float, str]]:
+    """A scene's co-simulation with compiled kernels against the Python fallback, and
+    against the compiled and the Python monolithic model (tolerance 1e-6): medians of
+    process times, the two paths' processes run in turn."""
     times: dict[bool, dict[str, list[float]]] = {
         p: {"cosim": [], "monolithic": []} for p in (False, True)
     }
     compiled = True
     for _ in range(KERNEL_ROUNDS):
         for pure in (False, True):
-            got = _kernel_process(pure)
+            got = _kernel_process(pure, scene_file, kernel)
             compiled = compiled and (pure or bool(got["compiled"]))
             for what in ("cosim", "monolithic"):
                 times[pure][what] += got[what]  # type: ignore[operator]
@@ -494,24 +517,28 @@ def _kernel_rows() -> list[tuple[str, float, str]]:
     fast = {k: statistics.median(v) for k, v in times[False].items()}
     slow = {k: statistics.median(v) for k, v in times[True].items()}
     print(
-        f"M739 as written, CPU time: co-simulation {fast['cosim']:.3f} s compiled, "
+        f"{name} as written, CPU time: co-simulation {fast['cosim']:.3f} s compiled, "
         f"{slow['cosim']:.3f} s Python; monolithic (1e-6) {fast['monolithic']:.3f} s "
         f"compiled, {slow['monolithic']:.3f} s Python"
     )
     return [
-        ("M739 co-simulation: Python fallback / compiled", slow["cosim"] / fast["cosim"], ">= 3.5"),
         (
-            "M739 co-simulation, compiled / compiled monolithic (1e-6)",
+            f"{name} co-simulation: Python fallback / compiled",
+            slow["cosim"] / fast["cosim"],
+            speedup,
+        ),
+        (
+            f"{name} co-simulation, compiled / compiled monolithic (1e-6)",
             fast["cosim"] / fast["monolithic"],
             "<= 4",
         ),
         (
-            "M739 co-simulation, compiled / Python monolithic (1e-6)",
+            f"{name} co-simulation, compiled / Python monolithic (1e-6)",
             fast["cosim"] / slow["monolithic"],
             "",
         ),
         (
-            "M739 monolithic (1e-6): Python / compiled",
+            f"{name} monolithic (1e-6): Python / compiled",
             slow["monolithic"] / fast["monolithic"],
             "",
         ),

@@ -10,10 +10,12 @@ from collections.abc import Mapping
 
 from components.clock_gear_train import LOSS_POINT, ClockTrainPhysics
 from components.clock_train_design import body_data, clock_train, design_defaults
+from components.kernels import load_kernel
 from components.m739_data import M739, M739Data, rpm_to_rad_s
 from components.verge_escapement import (
     IND_MESH_HI,
     IND_MESH_LO,
+    StepBudgetSpent,
     VergeConstants,
     escapement_data,
 )
@@ -51,6 +53,16 @@ class _ClockMonolithic(VergeTrainMonolithic):
             y = self._sync_kinematics(y)
         self.record(y)
         return y
+
+
+_KERNEL = load_kernel("clock_train_kernel")
+if _KERNEL is not None:  # its integration between events runs compiled (components.kernels)
+    _M739_KERNEL = load_kernel("m739_kernel")  # whose Sampler ``simulate`` observes with
+    _KERNEL.use_classes(
+        monolithic=_ClockMonolithic,
+        verge_budget_spent=StepBudgetSpent,
+        sampler=None if _M739_KERNEL is None else _M739_KERNEL.Sampler,
+    )
 
 
 def arming_phi(phys: ClockTrainPhysics, rotor_angle: float = ARMING_ROTOR_ANGLE) -> float:
