@@ -64,6 +64,8 @@ BUILD_CODE = (
     FMUS_DIR / "bytecode.py",
     LOADER_SOURCE,
 )
+#: where component code loads a compiled kernel (``components.kernels.load_kernel``)
+_LOAD_KERNEL = re.compile(r"""load_kernel\(\s*["'](\w+)["']\s*\)""")
 #: the date of every entry of an FMU archive (the earliest a zip file can hold)
 ZIP_DATE = (1980, 1, 1, 0, 0, 0)
 
@@ -123,8 +125,12 @@ def build_fmu(name: str, cache_dir: Path | None = None, force: bool = False) -> 
 
 
 def _kernels(modules: list[Path]) -> list[str]:
-    """The compiled kernels an FMU ships: all of them where its code loads kernels."""
-    return sorted(KERNEL_SOURCES) if any(m.name == "kernels.py" for m in modules) else []
+    """The compiled kernels an FMU ships: those its code loads (``load_kernel("name")``),
+    so that an FMU carries, and its hash depends on, only the kernels it runs."""
+    named = set()
+    for module in modules:
+        named.update(_LOAD_KERNEL.findall(module.read_text(encoding="utf-8")))
+    return sorted(named & set(KERNEL_SOURCES))
 
 
 def package_name(digest: str) -> str:

@@ -179,3 +179,15 @@ def test_both_paths_agree_on_the_m739_monolithic_model(tmp_path: Path) -> None:
         _run(False, "-", tmp_path, 0.2)["monolithic"]
         == _run(True, "-", tmp_path, 0.2)["monolithic"]
     )
+
+
+def test_an_fmu_ships_only_the_kernels_its_code_loads() -> None:
+    from fmus.build import _kernels
+    from fmus.registry import FMU_RECORDS
+
+    def shipped(name: str) -> list[str]:
+        return _kernels(FMU_RECORDS[name].modules())
+
+    assert shipped("GearTrain") == ["m739_kernel"]
+    assert shipped("ClockGearTrain") == ["clock_train_kernel", "m739_kernel"]
+    assert shipped("Inertia") == []
