@@ -28,6 +28,7 @@ from fmus.host_loader import c_compiler, say_once
 COMPONENTS_DIR = Path(__file__).resolve().parent.parent / "components"
 #: kernel name -> its Cython source
 KERNEL_SOURCES = {"m739_kernel": COMPONENTS_DIR / "m739_kernel.pyx"}
+KERNEL_SOURCES["press_feed_kernel"] = COMPONENTS_DIR / "press_feed_kernel.pyx"
 FLAGS = (
     "-O2",
     "-fPIC",

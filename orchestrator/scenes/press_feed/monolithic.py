@@ -50,6 +50,7 @@ from components.crank_coupler_drive import (
     rocker_motion,
     strain_factors,
 )
+from components.kernels import load_kernel
 from components.press_feed_data import (
     APP_H_F2,
     APP_H_FOURIER,
@@ -260,6 +261,15 @@ class _Nonlinear:
             clutch_energy(w, self.k),
             0.5 * self.j5 * y[3] ** 2,
         )
+
+
+_KERNEL = load_kernel("press_feed_kernel")
+if _KERNEL is not None:  # its right-hand side and signals run compiled (components.kernels)
+    _KERNEL.use_reference(N_DAMP, REGIME_STICK, REGIME_SLIP_FORWARD, REGIME_SLIP_BACKWARD)
+    _KERNEL.use_python(signals=_Nonlinear.signals, rhs=_Nonlinear.rhs, observe=_Nonlinear.observe)
+    _Nonlinear.signals = _KERNEL.nonlinear_signals  # type: ignore[method-assign]
+    _Nonlinear.rhs = _KERNEL.nonlinear_rhs  # type: ignore[method-assign]
+    _Nonlinear.observe = _KERNEL.nonlinear_observe  # type: ignore[method-assign]
 
 
 # -- the linearized App. C/H model ----------------------------------------------------------
