@@ -22,6 +22,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 
+import numpy as np
+
 from .base import (
     COMMON_OUTPUTS,
     Component,
@@ -157,6 +159,13 @@ def rocker_motion(
     """(theta4, theta4') of the rocker, forward positive (14)."""
     p4, d4, _, f2, f2d, _ = kin if kin is not None else m.kin(phi1)
     return m.phi4_max - (p4 + f2 * q), -(m.omega * (d4 + f2d * q) + f2 * qd)
+
+
+def rocker_angles(m: DriveModel, phi1: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """theta4 of the rocker (rocker_motion's angle) at each crank angle and deflection."""
+    return np.array(
+        [m.phi4_max - (p[0] + p[3] * qk) for p, qk in zip(map(m.kin, phi1), q, strict=True)]
+    )
 
 
 def coupler_energy(m: DriveModel, q: float, qd: float, theta4_d: float) -> float:
@@ -552,6 +561,7 @@ if _KERNEL is not None:  # the compiled twins (components.kernels): the same res
     _KERNEL.use_python(
         coupler_derivatives=coupler_derivatives,
         rocker_motion=rocker_motion,
+        rocker_angles=rocker_angles,
         deriv=_CouplerMotion.deriv,
         indicators=_CouplerMotion.indicators,
     )
@@ -559,5 +569,6 @@ if _KERNEL is not None:  # the compiled twins (components.kernels): the same res
     _KERNEL.use_integration(ComponentError, StepBudgetSpent, _fire_at_instant, _first_step)
     coupler_derivatives = _KERNEL.coupler_derivatives  # noqa: F811
     rocker_motion = _KERNEL.rocker_motion  # noqa: F811
+    rocker_angles = _KERNEL.rocker_angles  # noqa: F811
     _CouplerMotion.deriv = _KERNEL.coupler_motion_deriv  # type: ignore[method-assign]
     _CouplerMotion.indicators = _KERNEL.coupler_motion_indicators  # type: ignore[method-assign]

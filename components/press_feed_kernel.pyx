@@ -85,7 +85,7 @@ cdef double _pow(double x, double y) except? -2.0:
 
 
 # -- the classes and constants of the Python code ---------------------------------------
-cdef dict CLASSES = dict.fromkeys(("exact", "fourier", "coupler_motion", "advanced"))
+cdef dict CLASSES = dict.fromkeys(("exact", "fourier", "coupler_motion", "advanced", "nonlinear"))
 cdef object COMPONENT_ERROR = RuntimeError
 cdef object BUDGET_SPENT = RuntimeError  # event_integration.StepBudgetSpent
 cdef object FIRE_AT_INSTANT = None
@@ -96,7 +96,8 @@ cdef int STICK = 0, SLIP_FORWARD = 1, SLIP_BACKWARD = 2
 
 def use_classes(**classes):
     """The classes the compiled code recognises (by role): exact, fourier (the rocker
-    models), coupler_motion (the drive's model over a step), advanced (advance's result)."""
+    models), coupler_motion (the drive's model over a step), advanced (advance's result),
+    nonlinear (the monolithic reference's machine)."""
     CLASSES.update(classes)
 
 
@@ -728,4 +729,49 @@ def nonlinear_rhs(self, t, y):
     v[8] = s.w if slipping else 0.0
     v[9] = s.trq if slipping else 0.0
     v[10] = 1.0 if slipping else 0.0
+    return out
+
+
+def nonlinear_observed(mach, times, states):
+    """monolithic._observed for a _Nonlinear: (windup, clutch torque) at each sample."""
+    cdef Signals s
+    cdef double Y[4]
+    cdef Py_ssize_t i, j, n
+    cdef const double[:] ts
+    cdef const double[:, :] ys
+    if type(mach) is not CLASSES["nonlinear"] or not _known(mach.m):
+        return PYTHON["observed"](mach, times, states)
+    ts = np.asarray(times, dtype=np.float64)
+    ys = np.asarray(states, dtype=np.float64)
+    n = ts.shape[0]
+    if ys.ndim != 2 or ys.shape[0] != n or ys.shape[1] < 4:
+        return PYTHON["observed"](mach, times, states)
+    out = []
+    for i in range(n):
+        for j in range(4):
+            Y[j] = ys[i, j]
+        _signals(mach, ts[i], Y, &s)
+        out.append((s.w, s.trq))
+    return out
+
+
+def rocker_angles(m, phi1, q):
+    """crank_coupler_drive.rocker_angles: theta4 at each sample."""
+    cdef double k[6]
+    cdef Py_ssize_t i, n
+    cdef const double[:] ps
+    cdef const double[:] qs
+    cdef double[:] v
+    if not _known(m):
+        return PYTHON["rocker_angles"](m, phi1, q)
+    ps = np.asarray(phi1, dtype=np.float64)
+    qs = np.asarray(q, dtype=np.float64)
+    n = ps.shape[0]
+    if ps.ndim != 1 or qs.ndim != 1 or qs.shape[0] != n:
+        return PYTHON["rocker_angles"](m, phi1, q)
+    out = np.empty(n)
+    v = out
+    for i in range(n):
+        _kin(&DRIVE.kin, ps[i], k)
+        v[i] = DRIVE.phi4_max - (k[0] + k[3] * qs[i])
     return out

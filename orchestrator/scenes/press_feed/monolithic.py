@@ -448,7 +448,7 @@ def _integrate(mach, y0: np.ndarray, t_end: float, o: FeedOptions, grid: np.ndar
         if mask.any():
             gt.append(grid[mask])
             gy.append(sol.sol(grid[mask]).T)
-            gw.append([mach.observe(tk, yk) for tk, yk in zip(gt[-1], gy[-1], strict=True)])
+            gw.append(_observed(mach, gt[-1], gy[-1]))
         ts.extend(sol.t[1:])
         ys.extend(sol.y[:, 1:].T)
         t, y = t_stop, sol.y[:, -1].copy()
@@ -484,6 +484,17 @@ def _integrate(mach, y0: np.ndarray, t_end: float, o: FeedOptions, grid: np.ndar
     series_y = np.vstack(gy) if gy else np.empty((0, NY))
     series_w = np.vstack(gw) if gw else np.empty((0, 2))
     return series_t, series_y, series_w, np.array(ts), np.array(ys), log, events
+
+
+def _observed(mach, times: np.ndarray, states: np.ndarray) -> list[tuple[float, float]]:
+    """(windup, clutch torque) at each sample."""
+    return [mach.observe(tk, yk) for tk, yk in zip(times, states, strict=True)]
+
+
+if _KERNEL is not None:  # the samples of the nonlinear model taken in C
+    _KERNEL.use_python(observed=_observed)
+    _KERNEL.use_classes(nonlinear=_Nonlinear)
+    _observed = _KERNEL.nonlinear_observed  # noqa: F811
 
 
 def simulate_feed(o: FeedOptions = FeedOptions()) -> FeedResult:
