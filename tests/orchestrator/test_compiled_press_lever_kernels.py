@@ -48,6 +48,9 @@ from components.crank_coupler_drive import (
     STATE_SCALES, _advance, _CouplerMotion, build_drive_model)
 from components.event_integration import IntegrationStepControl, StepBudgetSpent
 from components.kernels import load_kernel
+from components.press_feed_data import LINKAGE_TABLE1
+from components.rssr_kinematics import ExactRSSR
+from dataclasses import replace
 from orchestrator.run import run_scene
 from orchestrator.scenario import load_scene
 from orchestrator.scenes import REFERENCES
@@ -93,6 +96,15 @@ if sys.argv[2] == "short":
         out["budget"] = ["done"]
     except StepBudgetSpent as exc:
         out["budget"] = [type(exc).__module__, str(exc)]
+    # Linkages that assemble over part of the turn or not at all: values, or the same error.
+    out["kinematics"] = []
+    for stretch in (1.0, 1.02, 1.05, 2.0):
+        kin = ExactRSSR(replace(LINKAGE_TABLE1, a3=LINKAGE_TABLE1.a3 * stretch), 0.4)
+        for k in range(24):
+            try:
+                out["kinematics"].append(exact(kin(k * 0.2618)))
+            except (ArithmeticError, ValueError) as exc:
+                out["kinematics"].append([type(exc).__name__, str(exc)])
     done = _advance(_CouplerMotion(m, 5.0, 1.0, 10.0, 0.1), [0.1, 0.0, 0.0, 0.0, 0.0], 0.3,
                     IntegrationStepControl(1e-8, STATE_SCALES, 1e-3), 0.0)
     out["advance"] = repr(tuple(done))
@@ -200,6 +212,15 @@ def test_both_paths_agree_on_the_press_feed_references(short_runs: tuple[dict, d
         "rigid_decay",
     }
     assert compiled["advance"] == python["advance"]
+
+
+@needs_kernels
+def test_both_paths_agree_where_a_linkage_does_not_assemble(short_runs: tuple[dict, dict]) -> None:
+    compiled, python = short_runs
+    assert compiled["kinematics"] == python["kinematics"]
+    refused = [k for k in compiled["kinematics"] if isinstance(k, list)]
+    assert ["ValueError", "math domain error"] in refused  # the square root of (A.8)
+    assert len(refused) < len(compiled["kinematics"])  # and values where it assembles
 
 
 @needs_kernels
