@@ -102,7 +102,7 @@ def use_classes(**classes):
 
 
 def use_integration(component_error, budget_spent, fire_at_instant, first_step):
-    """event_integration's errors and the helpers its compiled loop calls back."""
+    """event_integration's errors and the functions its compiled loop calls back."""
     global COMPONENT_ERROR, BUDGET_SPENT, FIRE_AT_INSTANT, FIRST_STEP
     COMPONENT_ERROR, BUDGET_SPENT = component_error, budget_spent
     FIRE_AT_INSTANT, FIRST_STEP = fire_at_instant, first_step
