@@ -22,6 +22,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 
+import numpy as np
+
 from .base import (
     COMMON_OUTPUTS,
     Component,
@@ -33,7 +35,17 @@ from .base import (
 )
 from .coupler_inertia import computed_inertia
 from .design_rules import raise_first
-from .event_integration import advance, integration_step_control, integration_variables
+from .event_integration import (
+    Advanced,
+    IntegrationStepControl,
+    StepBudgetSpent,
+    _fire_at_instant,
+    _first_step,
+    advance,
+    integration_step_control,
+    integration_variables,
+)
+from .kernels import load_kernel
 from .press_feed_data import (
     APP_H_FOURIER,
     COUPLER_STANDARD,
@@ -147,6 +159,13 @@ def rocker_motion(
     """(theta4, theta4') of the rocker, forward positive (14)."""
     p4, d4, _, f2, f2d, _ = kin if kin is not None else m.kin(phi1)
     return m.phi4_max - (p4 + f2 * q), -(m.omega * (d4 + f2d * q) + f2 * qd)
+
+
+def rocker_angles(m: DriveModel, phi1: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """theta4 of the rocker (rocker_motion's angle) at each crank angle and deflection."""
+    return np.array(
+        [m.phi4_max - (p[0] + p[3] * qk) for p, qk in zip(map(m.kin, phi1), q, strict=True)]
+    )
 
 
 def coupler_energy(m: DriveModel, q: float, qd: float, theta4_d: float) -> float:
@@ -510,7 +529,7 @@ class CrankCouplerDrive(Component):
             m, self.torque, 1.0 if forward else -1.0, self.torque_rate, phi1 + 0.5 * m.omega * h
         )
         y = [phi1, self.q, self.q_dot, self.input_work, self.dissipated_work]
-        done = advance(motion, y, h, self._control, self._h_next)
+        done = _advance(motion, y, h, self._control, self._h_next)
         self._h_next = done.h_next
         if done.events:
             self.event_time = t + done.t_last_event
@@ -519,3 +538,37 @@ class CrankCouplerDrive(Component):
         self.input_work, self.dissipated_work = wi, wd
         self._t = t + h
         self.update_outputs()
+
+
+def _advance(
+    motion: _CouplerMotion,
+    y: list[float],
+    h: float,
+    control: IntegrationStepControl,
+    h_try: float,
+) -> Advanced:
+    """event_integration.advance over one step: compiled where the kernel knows the
+    drive's rocker model, else the Python loop."""
+    if _KERNEL is not None:
+        done = _KERNEL.coupler_advance(motion, y, h, control, h_try)
+        if done is not None:
+            return done
+    return advance(motion, y, h, control, h_try)
+
+
+_KERNEL = load_kernel("press_feed_kernel")
+if _KERNEL is not None:  # the compiled twins (components.kernels): the same results
+    _KERNEL.use_python(
+        coupler_derivatives=coupler_derivatives,
+        rocker_motion=rocker_motion,
+        rocker_angles=rocker_angles,
+        deriv=_CouplerMotion.deriv,
+        indicators=_CouplerMotion.indicators,
+    )
+    _KERNEL.use_classes(coupler_motion=_CouplerMotion, advanced=Advanced)
+    _KERNEL.use_integration(ComponentError, StepBudgetSpent, _fire_at_instant, _first_step)
+    coupler_derivatives = _KERNEL.coupler_derivatives  # noqa: F811
+    rocker_motion = _KERNEL.rocker_motion  # noqa: F811
+    rocker_angles = _KERNEL.rocker_angles  # noqa: F811
+    _CouplerMotion.deriv = _KERNEL.coupler_motion_deriv  # type: ignore[method-assign]
+    _CouplerMotion.indicators = _KERNEL.coupler_motion_indicators  # type: ignore[method-assign]

@@ -14,6 +14,7 @@ import math
 
 import numpy as np
 
+from .kernels import load_kernel
 from .press_feed_data import RSSRLinkage
 
 Kinematics = tuple[float, float, float, float, float, float]
@@ -116,3 +117,9 @@ def rocker_extremes(kin: ExactRSSR | FourierRocker) -> tuple[float, float, float
                 break
         out.extend([kin(p)[0], p % (2.0 * math.pi)])
     return out[0], out[1], out[2], out[3]
+
+
+_KERNEL = load_kernel("press_feed_kernel")
+if _KERNEL is not None:  # the compiled twin (components.kernels): the same results
+    _KERNEL.use_classes(exact=ExactRSSR, fourier=FourierRocker)
+    ExactRSSR.__call__ = _KERNEL.exact_rssr_call  # type: ignore[method-assign]

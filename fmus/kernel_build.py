@@ -27,8 +27,10 @@ from fmus.host_loader import c_compiler, say_once
 
 COMPONENTS_DIR = Path(__file__).resolve().parent.parent / "components"
 #: kernel name -> its Cython source
-KERNEL_SOURCES = {"m739_kernel": COMPONENTS_DIR / "m739_kernel.pyx"}
-KERNEL_SOURCES["clock_train_kernel"] = COMPONENTS_DIR / "clock_train_kernel.pyx"
+KERNEL_SOURCES = {
+    name: COMPONENTS_DIR / f"{name}.pyx"
+    for name in ("m739_kernel", "clock_train_kernel", "press_feed_kernel")
+}
 FLAGS = (
     "-O2",
     "-fPIC",

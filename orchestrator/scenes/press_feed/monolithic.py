@@ -50,6 +50,7 @@ from components.crank_coupler_drive import (
     rocker_motion,
     strain_factors,
 )
+from components.kernels import load_kernel
 from components.press_feed_data import (
     APP_H_F2,
     APP_H_FOURIER,
@@ -262,6 +263,15 @@ class _Nonlinear:
         )
 
 
+_KERNEL = load_kernel("press_feed_kernel")
+if _KERNEL is not None:  # its right-hand side and signals run compiled (components.kernels)
+    _KERNEL.use_reference(N_DAMP, REGIME_STICK, REGIME_SLIP_FORWARD, REGIME_SLIP_BACKWARD)
+    _KERNEL.use_python(signals=_Nonlinear.signals, rhs=_Nonlinear.rhs, observe=_Nonlinear.observe)
+    _Nonlinear.signals = _KERNEL.nonlinear_signals  # type: ignore[method-assign]
+    _Nonlinear.rhs = _KERNEL.nonlinear_rhs  # type: ignore[method-assign]
+    _Nonlinear.observe = _KERNEL.nonlinear_observe  # type: ignore[method-assign]
+
+
 # -- the linearized App. C/H model ----------------------------------------------------------
 class _Linearized:
     """Thesis regimes imposed: K_l1 / K_l2 - T_b/2 / K_l3 / 0, events D.3, 62, E.3, F.3."""
@@ -438,7 +448,7 @@ def _integrate(mach, y0: np.ndarray, t_end: float, o: FeedOptions, grid: np.ndar
         if mask.any():
             gt.append(grid[mask])
             gy.append(sol.sol(grid[mask]).T)
-            gw.append([mach.observe(tk, yk) for tk, yk in zip(gt[-1], gy[-1], strict=True)])
+            gw.append(_observed(mach, gt[-1], gy[-1]))
         ts.extend(sol.t[1:])
         ys.extend(sol.y[:, 1:].T)
         t, y = t_stop, sol.y[:, -1].copy()
@@ -474,6 +484,17 @@ def _integrate(mach, y0: np.ndarray, t_end: float, o: FeedOptions, grid: np.ndar
     series_y = np.vstack(gy) if gy else np.empty((0, NY))
     series_w = np.vstack(gw) if gw else np.empty((0, 2))
     return series_t, series_y, series_w, np.array(ts), np.array(ys), log, events
+
+
+def _observed(mach, times: np.ndarray, states: np.ndarray) -> list[tuple[float, float]]:
+    """(windup, clutch torque) at each sample."""
+    return [mach.observe(tk, yk) for tk, yk in zip(times, states, strict=True)]
+
+
+if _KERNEL is not None:  # the samples of the nonlinear model taken in C
+    _KERNEL.use_python(observed=_observed)
+    _KERNEL.use_classes(nonlinear=_Nonlinear)
+    _observed = _KERNEL.nonlinear_observed  # noqa: F811
 
 
 def simulate_feed(o: FeedOptions = FeedOptions()) -> FeedResult:

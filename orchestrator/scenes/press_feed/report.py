@@ -27,6 +27,7 @@ from components.crank_coupler_drive import (
     REGIME_FORWARD,
     CrankCouplerDrive,
     build_drive_model,
+    rocker_angles,
     with_inertia,
 )
 from components.crank_coupler_drive import REGIME_NAMES as DRIVE_NAMES
@@ -571,12 +572,7 @@ def reference(scene: Scene) -> Reference:
     headline = reference_quantities(res, fs, duration, scene.report_options)
     s = res.series
     drive = build_drive_model(opts.rpm, fs.linkage(), fs.coupler(), f1=fs.f1(), rigid=fs.rigid)
-    theta4 = np.array(
-        [
-            drive.phi4_max - (p[0] + p[3] * q)
-            for p, q in zip(map(drive.kin, s["phi1"]), s["q"], strict=True)
-        ]
-    )
+    theta4 = rocker_angles(drive, s["phi1"], s["q"])
     ref_t = s["t"]
     columns = {
         f"{fs.clutch}.windup": s["windup"],
