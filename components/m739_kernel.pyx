@@ -1461,3 +1461,140 @@ def advance(model, y, double h_total, control, double h_try, double tol_t, long 
     run = _VergeRun()
     run.setup(model, core, moments, n_own)
     return run.run(list(y), h_total, control, h_try, tol_t, max_events, observe)
+
+
+# -- components.verge_escapement.VergeEscapement: its Python around the loop --------------
+# The component's inputs taken, the events the jump to them crossed, its outputs: the same
+# C functions as the loop, the mode read for each call; the Python methods for a core whose
+# train is neither kind.
+cdef dict PYTHON_COMPONENT = {}
+
+
+def use_python_component(**functions):
+    """VergeEscapement's Python _take_inputs, _resync_events and _outputs."""
+    PYTHON_COMPONENT.update(functions)
+
+
+def component_take_inputs(self):
+    """VergeEscapement._take_inputs."""
+    cdef double kn[7]
+    cdef double phi_dot
+    cdef int face
+    core, held = self._core, self._held
+    held.j_ref, held.t_ref, held.c_load, held.i_stot = (
+        self.J_ref, self.T_ref, self.c_load, self.J_stot
+    )
+    held.j_phi, held.t_phi, held.t_w = self.J_ref_phi, self.T_ref_phi, self.T_ref_phi_dot
+    phi, w = self.phi, self.phi_dot
+    held.phi0, held.w0 = phi, w
+    held.i_phi = self.J_stot_phi
+    phi_dot = w
+    if phi_dot != 0.0:
+        held.direction = -1 if phi_dot < 0.0 else 1
+    last = self._y
+    if not core.coupled:
+        return [phi, w, last[2], last[3], last[4]]
+    # VergeCore._sync_kinematics
+    k = core.k
+    face = core.face
+    _kinem_c(<double>phi + <double>core.phi_off, k.alpha[face], k.a, k.b, k.c, kn)
+    return [phi, w, kn[0], kn[2] * phi_dot, last[4]]
+
+
+def component_resync_events(self, y):
+    """VergeEscapement._resync_events."""
+    cdef double Y[5]
+    cdef double g[16]
+    cdef Py_ssize_t i, hit, n
+    cdef _VergeRun run
+    core = self._core
+    for _ in range(8):
+        run = _bare_run(core, y)
+        g_end = self._g_end
+        if run is None or len(g_end) != run.n_ind:
+            return PYTHON_COMPONENT["resync_events"](self, y)
+        for i in range(5):
+            Y[i] = y[i]
+        try:
+            run.indicators(Y, g)
+        finally:
+            if run.has_budget:
+                core.budget = run.budget
+        n = run.n_ind
+        hit = -1
+        for i in range(n):
+            if <double>g_end[i] >= 0.0 and 0.0 > g[i]:
+                hit = i
+                break
+        if hit < 0:
+            break
+        y = core.event(y, hit, 0.0)
+        self._g_end = core.indicators(y)
+    return y
+
+
+def component_outputs(self, y):
+    """VergeEscapement._outputs."""
+    cdef double Y[5]
+    cdef double o[13]
+    cdef double acc, psi, psi_d, u, pn, phi_l, alpha, arg, psi_y, g_arm, a1p, d1p, body
+    cdef int sigma, fi
+    cdef Py_ssize_t i
+    core = self._core
+    # (a core with a budget spends it on the indicators the Python code evaluates here)
+    cdef _VergeRun run = None if core.budget is not None else _bare_run(core, y)
+    if run is None:
+        return PYTHON_COMPONENT["outputs"](self, y)
+    for i in range(5):
+        Y[i] = y[i]
+    sigma = run.face
+    fi = _fidx(sigma)
+    alpha = run.alpha[fi]
+    if run.coupled:
+        run.coupled_terms(Y[0], Y[1], o)
+        acc, psi, psi_d, pn, u = o[0], o[1], o[2], o[4], o[7]
+        self.PN, self.T_esc, self.ind_pn = pn, o[5], pn
+        self.T_esc_static, self.J_esc = o[11], o[12]
+        self.J_load = run.ip * u * u
+        self.ind_face_end = sigma * o[6]
+        self.ind_gap = 0.0
+        psi_local, psi_dot = psi, psi_d
+    else:
+        run.free_terms(Y, o)
+        acc = o[0]
+        psi_local, psi_dot = y[2], y[3]
+        psi, psi_d = Y[2], Y[3]
+        self.PN = self.T_esc = self.ind_pn = self.J_load = 0.0
+        self.T_esc_static = self.J_esc = 0.0
+        # VergeCore.indicators: its first two in free motion
+        phi_l = Y[0] + run.phi_off
+        arg = phi_l - psi - alpha
+        self.ind_face_end = sigma * (
+            run.a * _cos(psi + alpha) + run.b * _cos(arg) - run.c * _cos(alpha)
+        )
+        self.ind_gap = sigma * (
+            run.a * _sin(psi + alpha) - run.b * _sin(arg) - run.c * _sin(alpha)
+        )
+    self.PN_peak = core.pn_peak
+    # VergeCore.closing_speed (verge_geometry.face_arms)
+    phi_l = Y[0] + run.phi_off
+    psi_y = Y[2]
+    g_arm = (run.b * _sin(phi_l) - run.c * _sin(psi_y)) / _sin(psi_y + alpha)
+    a1p = run.b * _cos(phi_l - psi_y - alpha)
+    d1p = run.c * _cos(alpha) + g_arm
+    self.v_close = sigma * (a1p * Y[1] - d1p * Y[3])
+    self.phi_ddot = acc
+    self.phi_own, self.phi_dot_own = y[0], y[1]
+    self.psi_local = psi_local
+    self.psi_dot = psi_dot
+    body = psi + run.psic - <double>core.k.d.psic
+    self.psi = atan2(_sin(body), _cos(body))
+    self.phi_local = Y[0] + run.phi_off
+    self.face = core.face
+    self.regime = core.regime
+    self.impact_count = core.impacts
+    last = core.last_impact
+    self.phi_dot_post, self.psi_dot_post = last[2], last[3]
+    self.stored_energy = 0.5 * run.ip * psi_d * psi_d
+    self.external_work = run.a54 * (_cos(run.gamma_pp - psi - run.psic) - <double>self._cos0)
+    self.dissipated_work = y[4]
