@@ -1379,15 +1379,44 @@ def use_python_verge(**functions):
     PYTHON_VERGE.update(functions)
 
 
+# The constants of the last VergeConstants a held-train core was run with: a component's
+# core keeps its constants (the snapshots share them), so each call reads only the mode.
+cdef object _BARE_K = None
+cdef _VergeRun _BARE_CONSTANTS = None
+
+
 cdef _VergeRun _bare_run(object core, object y):
+    global _BARE_K, _BARE_CONSTANTS
+    cdef _VergeRun run, known
+    cdef bint held
     train = core.train
     if CLASSES["verge_core"] is None or len(y) < 5:
         return None
-    if type(train) is not CLASSES["held_train"] and type(train) is not CLASSES["live_train"]:
+    held = type(train) is CLASSES["held_train"]
+    if not held and type(train) is not CLASSES["live_train"]:
         return None
     run = _VergeRun()
     run.bare = True
+    k = core.k
+    if held and k is _BARE_K:
+        known = _BARE_CONSTANTS
+        run.model, run.core, run.train = None, core, train
+        run.monolithic = run.live = run.moments = False
+        run.n_own = run.n = 5
+        run.n_ind = 9
+        run.a, run.b, run.c, run.mu1, run.mu_abs = known.a, known.b, known.c, known.mu1, known.mu_abs
+        run.om2, run.om_abs, run.beta3, run.gamma_pp = known.om2, known.om_abs, known.beta3, known.gamma_pp
+        run.dn1, run.ip, run.a54, run.rho3, run.rho_p = known.dn1, known.ip, known.a54, known.rho3, known.rho_p
+        run.rcp, run.mp, run.r4 = known.rcp, known.mp, known.r4
+        run.alpha[0], run.alpha[1], run.c1[0], run.c1[1] = (
+            known.alpha[0], known.alpha[1], known.c1[0], known.c1[1]
+        )
+        run.phi_stop = core.phi_stop
+        run.load()
+        return run
     run.setup(None, core, False, 5)
+    if held:
+        _BARE_K, _BARE_CONSTANTS = k, run
     return run
 
 
