@@ -1627,3 +1627,76 @@ def component_outputs(self, y):
     self.stored_energy = 0.5 * run.ip * psi_d * psi_d
     self.external_work = run.a54 * (_cos(run.gamma_pp - psi - run.psic) - <double>self._cos0)
     self.dissipated_work = y[4]
+
+
+# -- components.gear_train.GearTrain: its outputs ------------------------------------------
+# The response, its slopes (components.train_component.TrainComponent._send_response) and the
+# mesh forces from the same C function as the loop; the Python method for other physics.
+cdef dict PYTHON_TRAIN = {}
+cdef double SLOPE_STEP_ANGLE = 0.0, SLOPE_STEP_SPEED = 0.0
+cdef object TRAIN_STUCK = None, TRAIN_FORWARD = None, TRAIN_BACKWARD = None
+
+
+def use_python_train(outputs, slope_steps, regimes):
+    """GearTrain's Python _outputs, the slopes' steps (angle, speed) and the regime codes
+    (stuck, forward, backward)."""
+    global SLOPE_STEP_ANGLE, SLOPE_STEP_SPEED, TRAIN_STUCK, TRAIN_FORWARD, TRAIN_BACKWARD
+    PYTHON_TRAIN["outputs"] = outputs
+    SLOPE_STEP_ANGLE, SLOPE_STEP_SPEED = slope_steps
+    TRAIN_STUCK, TRAIN_FORWARD, TRAIN_BACKWARD = regimes
+
+
+def train_outputs(self):
+    """GearTrain._outputs."""
+    cdef double P[7]
+    cdef double N[7]
+    cdef double phi, w, j_0, t_0, i_0, dp, dw, speed, acc, f12, f23
+    cdef _Loop run
+    p, m = self._phys, self._model
+    if type(p) is not CLASSES["live_train"] or type(m) is not CLASSES["train_model"]:
+        return PYTHON_TRAIN["outputs"](self)
+    phi_o, w_o, wd = self._y
+    phi, w = phi_o, w_o
+    run = _Loop()
+    run.setup_live(p)
+    run.load_live(p)
+    # TrainComponent._send_response
+    run.parts(phi, w, P)
+    j_0, t_0 = P[0], P[1]
+    self.J_ref, self.T_ref, self.c_load = j_0, t_0, 1.0
+    i_stot = p.i_stot
+    self.J_stot = i_stot
+    key = (phi_o, w_o, p.mode_key())
+    if key != self._slopes_at:
+        # TrainComponent._slopes_of
+        i_0 = i_stot
+        dp = SLOPE_STEP_ANGLE
+        speed = fabs(w)
+        dw = SLOPE_STEP_SPEED * (speed if speed > 1.0 else 1.0)
+        run.parts(phi + dp, w, N)
+        j_hi, t_hi, i_hi = N[0], N[1], <double>i_stot
+        run.parts(phi, w + dw, N)
+        self._slopes = ((j_hi - j_0) / dp, (t_hi - t_0) / dp, (N[1] - t_0) / dw, (i_hi - i_0) / dp)
+        self._slopes_at = key
+    self.J_ref_phi, self.T_ref_phi, self.T_ref_phi_dot, self.J_stot_phi = self._slopes
+    # TrainLoadModel.accel (c_load = 1)
+    acc = 0.0 if m.stuck else (t_0 + 1.0 * <double>m.t_esc) / (j_0 + 1.0 * <double>m.j_esc)
+    self.phi, self.phi_dot, self.phi_ddot = phi_o, w_o, acc
+    # TrainPhysics.forces
+    f23 = P[2] + P[3] * acc
+    f12 = (f23 * P[6] + run.t2 * P[5] - run.i2 * run.n32 * acc) / P[4]
+    self.F12, self.F23 = f12, f23
+    unloaded = self.T_esc == 0.0
+    self.FF12 = f12 if unloaded else 0.0
+    self.FF23 = f23 if unloaded else 0.0
+    phi1c = self._data.phi1c
+    self.rotor_angle = phi1c + run.n31 * phi
+    self.s1, self.s2 = p.s1, p.s2
+    self.indicator_mesh = run.phi_hi - phi if run.direction > 0 else phi - run.phi_lo
+    if m.stuck:
+        self.regime = TRAIN_STUCK
+    else:
+        self.regime = TRAIN_FORWARD if run.direction > 0 else TRAIN_BACKWARD
+    self.stored_energy = 0.5 * run.i_stot * w * w
+    self.external_work = run.a35 * (_cos(<double>phi1c + run.n31 * phi) - <double>self._cos0)
+    self.dissipated_work = wd
