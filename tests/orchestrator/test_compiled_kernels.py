@@ -166,7 +166,9 @@ def test_a_spent_step_budget_ends_both_paths_alike(short_runs: tuple[dict, dict]
 
 @pytest.mark.slow
 @needs_kernels
-@pytest.mark.parametrize("scene", ["m739.toml", "m739_from_deck.toml"])
+# The clock-train S&A: the M739 verge component (its compiled outputs, input take and event
+# resync) held against a train of another kind.
+@pytest.mark.parametrize("scene", ["m739.toml", "m739_from_deck.toml", "clock_train_sa.toml"])
 def test_both_paths_agree_on_the_m739_scenes(scene: str, tmp_path: Path) -> None:
     compiled = _run(False, f"{scene}:full", tmp_path / "c")
     assert compiled["csv"] == _run(True, f"{scene}:full", tmp_path / "py")["csv"]
