@@ -181,3 +181,28 @@ def test_both_paths_agree_on_the_m739_monolithic_model(tmp_path: Path) -> None:
         _run(False, "-", tmp_path, 0.2)["monolithic"]
         == _run(True, "-", tmp_path, 0.2)["monolithic"]
     )
+
+
+@needs_kernels
+def test_both_paths_give_every_output_of_the_m739_fmus_alike(tmp_path: Path) -> None:
+    """Every output of the verge and the train, not only those the scene records: the
+    compiled outputs set them all (5 ms of M739: contacts, impacts, free flights)."""
+    from components.gear_train import GearTrain
+    from components.verge_escapement import VergeEscapement
+
+    record = [
+        f"{fmu}.{v.name}"
+        for fmu, component in (("train", GearTrain), ("verge", VergeEscapement))
+        for v in component.VARIABLES
+        if v.causality == "output"
+    ]
+    text = (PROJECT / "scenarios" / "m739.toml").read_text()
+    scene, rest = text.split("[output]")
+    scene += f"[output]\nrecord = {json.dumps(record)}\n\n" + rest[rest.index("[report]") :]
+    path = tmp_path / "m739_every_output.toml"
+    path.write_text(scene)
+    compiled = _run(False, str(path), tmp_path / "c")
+    python = _run(True, str(path), tmp_path / "py")
+    assert compiled["csv"]["timeseries.csv"].splitlines()[0].count(b",") == len(record)
+    assert compiled["csv"]["timeseries.csv"].count(b"\n") > 10  # the run did move
+    assert compiled["csv"] == python["csv"]
