@@ -1404,9 +1404,10 @@ cdef _VergeRun _bare_run(object core, object y):
         run.monolithic = run.live = run.moments = False
         run.n_own = run.n = 5
         run.n_ind = 9
-        run.a, run.b, run.c, run.mu1, run.mu_abs = known.a, known.b, known.c, known.mu1, known.mu_abs
-        run.om2, run.om_abs, run.beta3, run.gamma_pp = known.om2, known.om_abs, known.beta3, known.gamma_pp
-        run.dn1, run.ip, run.a54, run.rho3, run.rho_p = known.dn1, known.ip, known.a54, known.rho3, known.rho_p
+        run.a, run.b, run.c = known.a, known.b, known.c
+        run.mu1, run.mu_abs, run.om2, run.om_abs = known.mu1, known.mu_abs, known.om2, known.om_abs
+        run.beta3, run.gamma_pp, run.dn1, run.ip = known.beta3, known.gamma_pp, known.dn1, known.ip
+        run.a54, run.rho3, run.rho_p = known.a54, known.rho3, known.rho_p
         run.rcp, run.mp, run.r4 = known.rcp, known.mp, known.r4
         run.alpha[0], run.alpha[1], run.c1[0], run.c1[1] = (
             known.alpha[0], known.alpha[1], known.c1[0], known.c1[1]
