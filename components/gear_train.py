@@ -60,7 +60,12 @@ from .event_integration import INTEGRATION_VARIABLES
 from .kernels import load_kernel
 from .m739_data import M739, M739Data
 from .sanda2v_deck import TRAIN, deck_variables, design_of, train_violations
-from .train_component import TrainComponent, TrainLoadModel
+from .train_component import (
+    SLOPE_STEP_ANGLE,
+    SLOPE_STEP_SPEED,
+    TrainComponent,
+    TrainLoadModel,
+)
 from .verge_geometry import train_angles
 
 INDEXING_PHYSICAL = 0
@@ -557,3 +562,9 @@ _KERNEL = load_kernel("m739_kernel")
 if _KERNEL is not None:  # the compiled twin (components.kernels): the same results
     TrainPhysics._parts = _KERNEL.train_parts
     _KERNEL.use_classes(live_train=TrainPhysics, train_model=_TrainModel)
+    _KERNEL.use_python_train(
+        GearTrain._outputs,
+        (SLOPE_STEP_ANGLE, SLOPE_STEP_SPEED),
+        (TRAIN_STUCK, TRAIN_FORWARD, TRAIN_BACKWARD),
+    )
+    GearTrain._outputs = _KERNEL.train_outputs  # type: ignore[method-assign]

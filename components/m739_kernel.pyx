@@ -1379,15 +1379,45 @@ def use_python_verge(**functions):
     PYTHON_VERGE.update(functions)
 
 
+# The constants of the last VergeConstants a held-train core was run with: a component's
+# core keeps its constants (the snapshots share them), so each call reads only the mode.
+cdef object _BARE_K = None
+cdef _VergeRun _BARE_CONSTANTS = None
+
+
 cdef _VergeRun _bare_run(object core, object y):
+    global _BARE_K, _BARE_CONSTANTS
+    cdef _VergeRun run, known
+    cdef bint held
     train = core.train
     if CLASSES["verge_core"] is None or len(y) < 5:
         return None
-    if type(train) is not CLASSES["held_train"] and type(train) is not CLASSES["live_train"]:
+    held = type(train) is CLASSES["held_train"]
+    if not held and type(train) is not CLASSES["live_train"]:
         return None
     run = _VergeRun()
     run.bare = True
+    k = core.k
+    if held and k is _BARE_K:
+        known = _BARE_CONSTANTS
+        run.model, run.core, run.train = None, core, train
+        run.monolithic = run.live = run.moments = False
+        run.n_own = run.n = 5
+        run.n_ind = 9
+        run.a, run.b, run.c = known.a, known.b, known.c
+        run.mu1, run.mu_abs, run.om2, run.om_abs = known.mu1, known.mu_abs, known.om2, known.om_abs
+        run.beta3, run.gamma_pp, run.dn1, run.ip = known.beta3, known.gamma_pp, known.dn1, known.ip
+        run.a54, run.rho3, run.rho_p = known.a54, known.rho3, known.rho_p
+        run.rcp, run.mp, run.r4 = known.rcp, known.mp, known.r4
+        run.alpha[0], run.alpha[1], run.c1[0], run.c1[1] = (
+            known.alpha[0], known.alpha[1], known.c1[0], known.c1[1]
+        )
+        run.phi_stop = core.phi_stop
+        run.load()
+        return run
     run.setup(None, core, False, 5)
+    if held:
+        _BARE_K, _BARE_CONSTANTS = k, run
     return run
 
 
@@ -1461,3 +1491,213 @@ def advance(model, y, double h_total, control, double h_try, double tol_t, long 
     run = _VergeRun()
     run.setup(model, core, moments, n_own)
     return run.run(list(y), h_total, control, h_try, tol_t, max_events, observe)
+
+
+# -- components.verge_escapement.VergeEscapement: its Python around the loop --------------
+# The component's inputs taken, the events the jump to them crossed, its outputs: the same
+# C functions as the loop, the mode read for each call; the Python methods for a core whose
+# train is neither kind.
+cdef dict PYTHON_COMPONENT = {}
+
+
+def use_python_component(**functions):
+    """VergeEscapement's Python _take_inputs, _resync_events and _outputs."""
+    PYTHON_COMPONENT.update(functions)
+
+
+def component_take_inputs(self):
+    """VergeEscapement._take_inputs."""
+    cdef double kn[7]
+    cdef double phi_dot
+    cdef int face
+    core, held = self._core, self._held
+    held.j_ref, held.t_ref, held.c_load, held.i_stot = (
+        self.J_ref, self.T_ref, self.c_load, self.J_stot
+    )
+    held.j_phi, held.t_phi, held.t_w = self.J_ref_phi, self.T_ref_phi, self.T_ref_phi_dot
+    phi, w = self.phi, self.phi_dot
+    held.phi0, held.w0 = phi, w
+    held.i_phi = self.J_stot_phi
+    phi_dot = w
+    if phi_dot != 0.0:
+        held.direction = -1 if phi_dot < 0.0 else 1
+    last = self._y
+    if not core.coupled:
+        return [phi, w, last[2], last[3], last[4]]
+    # VergeCore._sync_kinematics
+    k = core.k
+    face = core.face
+    _kinem_c(<double>phi + <double>core.phi_off, k.alpha[face], k.a, k.b, k.c, kn)
+    return [phi, w, kn[0], kn[2] * phi_dot, last[4]]
+
+
+def component_resync_events(self, y):
+    """VergeEscapement._resync_events."""
+    cdef double Y[5]
+    cdef double g[16]
+    cdef Py_ssize_t i, hit, n
+    cdef _VergeRun run
+    core = self._core
+    for _ in range(8):
+        run = _bare_run(core, y)
+        g_end = self._g_end
+        if run is None or len(g_end) != run.n_ind:
+            return PYTHON_COMPONENT["resync_events"](self, y)
+        for i in range(5):
+            Y[i] = y[i]
+        try:
+            run.indicators(Y, g)
+        finally:
+            if run.has_budget:
+                core.budget = run.budget
+        n = run.n_ind
+        hit = -1
+        for i in range(n):
+            if <double>g_end[i] >= 0.0 and 0.0 > g[i]:
+                hit = i
+                break
+        if hit < 0:
+            break
+        y = core.event(y, hit, 0.0)
+        self._g_end = core.indicators(y)
+    return y
+
+
+def component_outputs(self, y):
+    """VergeEscapement._outputs."""
+    cdef double Y[5]
+    cdef double o[13]
+    cdef double acc, psi, psi_d, u, pn, phi_l, alpha, arg, psi_y, g_arm, a1p, d1p, body
+    cdef int sigma, fi
+    cdef Py_ssize_t i
+    core = self._core
+    # (a core with a budget spends it on the indicators the Python code evaluates here)
+    cdef _VergeRun run = None if core.budget is not None else _bare_run(core, y)
+    if run is None:
+        return PYTHON_COMPONENT["outputs"](self, y)
+    for i in range(5):
+        Y[i] = y[i]
+    sigma = run.face
+    fi = _fidx(sigma)
+    alpha = run.alpha[fi]
+    if run.coupled:
+        run.coupled_terms(Y[0], Y[1], o)
+        acc, psi, psi_d, pn, u = o[0], o[1], o[2], o[4], o[7]
+        self.PN, self.T_esc, self.ind_pn = pn, o[5], pn
+        self.T_esc_static, self.J_esc = o[11], o[12]
+        self.J_load = run.ip * u * u
+        self.ind_face_end = sigma * o[6]
+        self.ind_gap = 0.0
+        psi_local, psi_dot = psi, psi_d
+    else:
+        run.free_terms(Y, o)
+        acc = o[0]
+        psi_local, psi_dot = y[2], y[3]
+        psi, psi_d = Y[2], Y[3]
+        self.PN = self.T_esc = self.ind_pn = self.J_load = 0.0
+        self.T_esc_static = self.J_esc = 0.0
+        # VergeCore.indicators: its first two in free motion
+        phi_l = Y[0] + run.phi_off
+        arg = phi_l - psi - alpha
+        self.ind_face_end = sigma * (
+            run.a * _cos(psi + alpha) + run.b * _cos(arg) - run.c * _cos(alpha)
+        )
+        self.ind_gap = sigma * (
+            run.a * _sin(psi + alpha) - run.b * _sin(arg) - run.c * _sin(alpha)
+        )
+    self.PN_peak = core.pn_peak
+    # VergeCore.closing_speed (verge_geometry.face_arms)
+    phi_l = Y[0] + run.phi_off
+    psi_y = Y[2]
+    g_arm = (run.b * _sin(phi_l) - run.c * _sin(psi_y)) / _sin(psi_y + alpha)
+    a1p = run.b * _cos(phi_l - psi_y - alpha)
+    d1p = run.c * _cos(alpha) + g_arm
+    self.v_close = sigma * (a1p * Y[1] - d1p * Y[3])
+    self.phi_ddot = acc
+    self.phi_own, self.phi_dot_own = y[0], y[1]
+    self.psi_local = psi_local
+    self.psi_dot = psi_dot
+    body = psi + run.psic - <double>core.k.d.psic
+    self.psi = atan2(_sin(body), _cos(body))
+    self.phi_local = Y[0] + run.phi_off
+    self.face = core.face
+    self.regime = core.regime
+    self.impact_count = core.impacts
+    last = core.last_impact
+    self.phi_dot_post, self.psi_dot_post = last[2], last[3]
+    self.stored_energy = 0.5 * run.ip * psi_d * psi_d
+    self.external_work = run.a54 * (_cos(run.gamma_pp - psi - run.psic) - <double>self._cos0)
+    self.dissipated_work = y[4]
+
+
+# -- components.gear_train.GearTrain: its outputs ------------------------------------------
+# The response, its slopes (components.train_component.TrainComponent._send_response) and the
+# mesh forces from the same C function as the loop; the Python method for other physics.
+cdef dict PYTHON_TRAIN = {}
+cdef double SLOPE_STEP_ANGLE = 0.0, SLOPE_STEP_SPEED = 0.0
+cdef object TRAIN_STUCK = None, TRAIN_FORWARD = None, TRAIN_BACKWARD = None
+
+
+def use_python_train(outputs, slope_steps, regimes):
+    """GearTrain's Python _outputs, the slopes' steps (angle, speed) and the regime codes
+    (stuck, forward, backward)."""
+    global SLOPE_STEP_ANGLE, SLOPE_STEP_SPEED, TRAIN_STUCK, TRAIN_FORWARD, TRAIN_BACKWARD
+    PYTHON_TRAIN["outputs"] = outputs
+    SLOPE_STEP_ANGLE, SLOPE_STEP_SPEED = slope_steps
+    TRAIN_STUCK, TRAIN_FORWARD, TRAIN_BACKWARD = regimes
+
+
+def train_outputs(self):
+    """GearTrain._outputs."""
+    cdef double P[7]
+    cdef double N[7]
+    cdef double phi, w, j_0, t_0, i_0, dp, dw, speed, acc, f12, f23
+    cdef _Loop run
+    p, m = self._phys, self._model
+    if type(p) is not CLASSES["live_train"] or type(m) is not CLASSES["train_model"]:
+        return PYTHON_TRAIN["outputs"](self)
+    phi_o, w_o, wd = self._y
+    phi, w = phi_o, w_o
+    run = _Loop()
+    run.setup_live(p)
+    run.load_live(p)
+    # TrainComponent._send_response
+    run.parts(phi, w, P)
+    j_0, t_0 = P[0], P[1]
+    self.J_ref, self.T_ref, self.c_load = j_0, t_0, 1.0
+    i_stot = p.i_stot
+    self.J_stot = i_stot
+    key = (phi_o, w_o, p.mode_key())
+    if key != self._slopes_at:
+        # TrainComponent._slopes_of
+        i_0 = i_stot
+        dp = SLOPE_STEP_ANGLE
+        speed = fabs(w)
+        dw = SLOPE_STEP_SPEED * (speed if speed > 1.0 else 1.0)
+        run.parts(phi + dp, w, N)
+        j_hi, t_hi, i_hi = N[0], N[1], <double>i_stot
+        run.parts(phi, w + dw, N)
+        self._slopes = ((j_hi - j_0) / dp, (t_hi - t_0) / dp, (N[1] - t_0) / dw, (i_hi - i_0) / dp)
+        self._slopes_at = key
+    self.J_ref_phi, self.T_ref_phi, self.T_ref_phi_dot, self.J_stot_phi = self._slopes
+    # TrainLoadModel.accel (c_load = 1)
+    acc = 0.0 if m.stuck else (t_0 + 1.0 * <double>m.t_esc) / (j_0 + 1.0 * <double>m.j_esc)
+    self.phi, self.phi_dot, self.phi_ddot = phi_o, w_o, acc
+    # TrainPhysics.forces
+    f23 = P[2] + P[3] * acc
+    f12 = (f23 * P[6] + run.t2 * P[5] - run.i2 * run.n32 * acc) / P[4]
+    self.F12, self.F23 = f12, f23
+    unloaded = self.T_esc == 0.0
+    self.FF12 = f12 if unloaded else 0.0
+    self.FF23 = f23 if unloaded else 0.0
+    phi1c = self._data.phi1c
+    self.rotor_angle = phi1c + run.n31 * phi
+    self.s1, self.s2 = p.s1, p.s2
+    self.indicator_mesh = run.phi_hi - phi if run.direction > 0 else phi - run.phi_lo
+    if m.stuck:
+        self.regime = TRAIN_STUCK
+    else:
+        self.regime = TRAIN_FORWARD if run.direction > 0 else TRAIN_BACKWARD
+    self.stored_energy = 0.5 * run.i_stot * w * w
+    self.external_work = run.a35 * (_cos(<double>phi1c + run.n31 * phi) - <double>self._cos0)
+    self.dissipated_work = wd

@@ -1274,3 +1274,12 @@ if _KERNEL is not None:  # the compiled twins (components.kernels): the same res
     _KERNEL.use_python_verge(indicators=VergeCore.indicators, deriv=VergeCore.deriv)
     VergeCore.indicators = _KERNEL.verge_indicators  # type: ignore[method-assign]
     VergeCore.deriv = _KERNEL.verge_deriv  # type: ignore[method-assign]
+    # and the component's own Python around the loop
+    _KERNEL.use_python_component(
+        take_inputs=VergeEscapement._take_inputs,
+        resync_events=VergeEscapement._resync_events,
+        outputs=VergeEscapement._outputs,
+    )
+    VergeEscapement._take_inputs = _KERNEL.component_take_inputs  # type: ignore[method-assign]
+    VergeEscapement._resync_events = _KERNEL.component_resync_events  # type: ignore[method-assign]
+    VergeEscapement._outputs = _KERNEL.component_outputs  # type: ignore[method-assign]

@@ -17,6 +17,9 @@ from orchestrator.restore_check import RestoreCheck
 from orchestrator.scene_model import Scene
 from orchestrator.signals import scene_signals
 
+#: which of values, ints, bools a value of a kind is read into (``record_row``)
+_KIND_LISTS = {"real": 0, "int": 1, "bool": 2}
+
 
 @dataclass
 class _Feed:
@@ -86,6 +89,10 @@ class CoupledSystem:
                 self.feeds[dst].real_refs.extend(target_ref)
         self.record_slots = [
             (self.index[inst],) + self._slot(self.index[inst], var) for inst, var in scene.record
+        ]
+        # the same as (0 Real, 1 Integer, 2 Boolean; instance, slot): read off at every row
+        self._record_plan = [
+            (_KIND_LISTS.get(kind, 2), i, slot) for i, kind, slot in self.record_slots
         ]
         self.watches = [self._watch(i) for i in range(len(self.names))]
         self.stop_slot: tuple[int, int] | None = None
@@ -332,12 +339,9 @@ class CoupledSystem:
             self.read(i)
 
     def record_row(self, t: float) -> list[float]:
+        lists = (self.values, self.ints, self.bools)
         row = [t]
-        for i, kind, slot in self.record_slots:
-            if kind == "real":
-                row.append(self.values[i][slot])
-            else:
-                row.append((self.ints if kind == "int" else self.bools)[i][slot])
+        row += [lists[kind][i][slot] for kind, i, slot in self._record_plan]
         return row
 
     def stop_indicator(self) -> float | None:

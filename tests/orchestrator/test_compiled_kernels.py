@@ -166,7 +166,9 @@ def test_a_spent_step_budget_ends_both_paths_alike(short_runs: tuple[dict, dict]
 
 @pytest.mark.slow
 @needs_kernels
-@pytest.mark.parametrize("scene", ["m739.toml", "m739_from_deck.toml"])
+# The clock-train S&A: the M739 verge component (its compiled outputs, input take and event
+# resync) held against a train of another kind.
+@pytest.mark.parametrize("scene", ["m739.toml", "m739_from_deck.toml", "clock_train_sa.toml"])
 def test_both_paths_agree_on_the_m739_scenes(scene: str, tmp_path: Path) -> None:
     compiled = _run(False, f"{scene}:full", tmp_path / "c")
     assert compiled["csv"] == _run(True, f"{scene}:full", tmp_path / "py")["csv"]
@@ -191,3 +193,28 @@ def test_an_fmu_ships_only_the_kernels_its_code_loads() -> None:
     assert shipped("GearTrain") == ["m739_kernel"]
     assert shipped("ClockGearTrain") == ["clock_train_kernel", "m739_kernel"]
     assert shipped("Inertia") == []
+
+
+@needs_kernels
+def test_both_paths_give_every_output_of_the_m739_fmus_alike(tmp_path: Path) -> None:
+    """Every output of the verge and the train, not only those the scene records: the
+    compiled outputs set them all (5 ms of M739: contacts, impacts, free flights)."""
+    from components.gear_train import GearTrain
+    from components.verge_escapement import VergeEscapement
+
+    record = [
+        f"{fmu}.{v.name}"
+        for fmu, component in (("train", GearTrain), ("verge", VergeEscapement))
+        for v in component.VARIABLES
+        if v.causality == "output"
+    ]
+    text = (PROJECT / "scenarios" / "m739.toml").read_text()
+    scene, rest = text.split("[output]")
+    scene += f"[output]\nrecord = {json.dumps(record)}\n\n" + rest[rest.index("[report]") :]
+    path = tmp_path / "m739_every_output.toml"
+    path.write_text(scene)
+    compiled = _run(False, str(path), tmp_path / "c")
+    python = _run(True, str(path), tmp_path / "py")
+    assert compiled["csv"]["timeseries.csv"].splitlines()[0].count(b",") == len(record)
+    assert compiled["csv"]["timeseries.csv"].count(b"\n") > 10  # the run did move
+    assert compiled["csv"] == python["csv"]
