@@ -1,7 +1,5 @@
 """``python -m orchestrator``: the ``mechcosim`` command."""
 
-import sys
+from orchestrator.entry import command
 
-from orchestrator.entry import main
-
-sys.exit(main())
+command()

@@ -11,9 +11,12 @@ runs) is left as it was.
 
 from __future__ import annotations
 
+import atexit
 import os
 import signal
 import sys
+import threading
+from typing import NoReturn
 
 from orchestrator.interrupt import (
     SIGNALS,
@@ -66,5 +69,26 @@ def main(argv: list[str] | None = None) -> int:
     return code
 
 
+def command() -> NoReturn:
+    """The ``mechcosim`` command as a process: ``main``, then the process ends at once.
+
+    The interpreter's own shutdown clears the 400-odd modules a run imports one by one,
+    0.15-0.27 s after the answer is printed: a third of what a repeated run of the M739
+    scene spends outside its co-simulation.  The exit handlers run first (logging's flush,
+    the extracted FMUs' removal, temporary folders), the streams are flushed, and the
+    process exits with the command's code.  With another thread still alive (one the
+    command did not stop) the interpreter ends the process as usual, joining it."""
+    code = main()
+    if threading.active_count() > 1:
+        sys.exit(code)
+    atexit._run_exitfuncs()  # what the interpreter's shutdown would run first
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            stream.flush()
+        except (OSError, ValueError):  # a closed pipe: the command's words are lost anyway
+            pass
+    os._exit(code)
+
+
 if __name__ == "__main__":
-    sys.exit(main())
+    command()
