@@ -10,6 +10,7 @@ its entries worked out again; one that cannot be written is not kept.
 
 from __future__ import annotations
 
+import importlib.util
 import json
 import os
 import tempfile
@@ -61,3 +62,28 @@ class DiskMemo:
             os.replace(partial, path)
         except OSError:
             pass  # an unwritable cache: worked out again next time
+
+
+def installed_version(package: str) -> str | None:
+    """The installed version of ``package`` (None if it is not installed), kept in a memo
+    keyed by where the package is installed and when: reading it from the installed
+    distributions imports ``importlib.metadata`` and scans them, 0.04-0.06 s a process."""
+    spec = importlib.util.find_spec(package)  # located, not imported
+    if spec is None or spec.origin is None:
+        return None
+    origin = Path(spec.origin)
+    key = f"{package}\x1f{origin}\x1f{origin.stat().st_mtime_ns}"
+    known = _VERSIONS.get(key)
+    if isinstance(known, str):
+        return known
+    from importlib import metadata
+
+    try:
+        version = metadata.version(package)
+    except metadata.PackageNotFoundError:
+        return None
+    _VERSIONS.put(key, version)
+    return version
+
+
+_VERSIONS = DiskMemo("installed-versions")

@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import contextlib
 import hashlib
-import importlib.util
 import json
 import os
 import shutil
@@ -22,6 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
+from fmus.disk_memo import installed_version
 from orchestrator.reference_cache import code_hash, scene_content
 from orchestrator.scene_model import Scene
 
@@ -75,19 +75,10 @@ def plot_key(scene: Scene, header: list[str], data: np.ndarray, path: Path) -> s
         "data": h.hexdigest(),
         "code": code_hash(str(scene.family)),
         "plotting": hashlib.sha256(_PLOTTING.read_bytes()).hexdigest(),
-        "matplotlib": _installed("matplotlib"),
+        "matplotlib": installed_version("matplotlib"),
     }
     text = json.dumps(content, sort_keys=True)
     return hashlib.sha256(text.encode()).hexdigest()[:32]
-
-
-def _installed(package: str) -> str:
-    """Where ``package`` is installed and when (located, not imported): an upgrade misses."""
-    spec = importlib.util.find_spec(package)
-    if spec is None or spec.origin is None:
-        return "absent"
-    origin = Path(spec.origin)
-    return f"{origin}:{origin.stat().st_mtime_ns}"
 
 
 def _keep(drawn: Path, kept: Path) -> None:

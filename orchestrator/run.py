@@ -14,13 +14,13 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from functools import cache
-from importlib import metadata
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from fmus.build import build_fmu, default_cache_dir
+from fmus.disk_memo import installed_version
 from orchestrator.accuracy import compare
 from orchestrator.analyses import energy_residual, headline, missing_column
 from orchestrator.errors import RunError
@@ -426,13 +426,7 @@ def reference_of(scene: Scene) -> Reference:
 @cache
 def _versions() -> dict[str, str | None]:
     """Installed versions (read once a process: a study runs hundreds of scenes in one)."""
-    versions: dict[str, str | None] = {}
-    for package in ("fmpy", "pythonfmu", "numpy", "scipy", "pint"):
-        try:
-            versions[package] = metadata.version(package)
-        except metadata.PackageNotFoundError:
-            versions[package] = None
-    return versions
+    return {p: installed_version(p) for p in ("fmpy", "pythonfmu", "numpy", "scipy", "pint")}
 
 
 def _metadata(scene: Scene, fmu_paths: dict[str, Path]) -> dict[str, Any]:

@@ -1,17 +1,16 @@
 """The conversions ``orchestrator.units.to_si`` has made, kept beside the FMUs
 (``fmus.disk_memo``) so that a later process converts the same texts without importing
-pint.  The memo's name hashes the conversion code and pint's installation: an edit of
-either starts an empty memo.  Numbers are stored by their ``repr``, which reads back to the
+pint.  The memo's name hashes the conversion code and pint's version: a change of either
+starts an empty memo.  Numbers are stored by their ``repr``, which reads back to the
 same bits."""
 
 from __future__ import annotations
 
 import hashlib
-import importlib.util
 from functools import cache
 from pathlib import Path
 
-from fmus.disk_memo import DiskMemo
+from fmus.disk_memo import DiskMemo, installed_version
 
 _CODE = (
     Path(__file__).resolve().with_name("units.py"),
@@ -22,14 +21,13 @@ _CODE = (
 @cache
 def _memo() -> DiskMemo | None:
     """This code's and this pint's memo; None where pint is not installed."""
-    spec = importlib.util.find_spec("pint")  # located, not imported
-    if spec is None or spec.origin is None:
+    version = installed_version("pint")
+    if version is None:
         return None
     h = hashlib.sha256()
     for path in _CODE:
         h.update(path.read_bytes())
-    origin = Path(spec.origin)
-    h.update(f"{origin}:{origin.stat().st_mtime_ns}".encode())
+    h.update(version.encode())
     return DiskMemo(f"units-{h.hexdigest()[:16]}")
 
 

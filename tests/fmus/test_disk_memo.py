@@ -53,3 +53,19 @@ def test_a_module_parsed_once_is_not_parsed_again(
     source.write_text("from .d import Z\n")  # an edit: a new content hash, parsed
     with pytest.raises(AssertionError, match="parsed again"):
         registry._relative_imports(source, 3, 3)
+
+
+def test_installed_versions_are_those_of_the_distributions(
+    cache: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from importlib import metadata
+
+    from fmus import disk_memo
+
+    monkeypatch.setattr(disk_memo, "_VERSIONS", DiskMemo("installed-versions"))
+    assert disk_memo.installed_version("numpy") == metadata.version("numpy")
+    assert disk_memo.installed_version("no_such_package_here") is None
+    # a later process: from the memo
+    monkeypatch.setattr(disk_memo, "_VERSIONS", DiskMemo("installed-versions"))
+    assert disk_memo.installed_version("numpy") == metadata.version("numpy")
+    assert any(k.startswith("numpy\x1f") for k in disk_memo._VERSIONS._loaded())
