@@ -23,7 +23,8 @@ from dataclasses import dataclass
 from functools import cache
 from pathlib import Path
 
-from fmus.host_loader import c_compiler, say_once
+from fmus.disk_memo import installed_version
+from fmus.host_loader import c_compiler, compiler_version, say_once
 
 COMPONENTS_DIR = Path(__file__).resolve().parent.parent / "components"
 #: kernel name -> its Cython source
@@ -67,12 +68,7 @@ def kernel_plan() -> KernelPlan:
     """What this environment can do, worked out once per process."""
     include = Path(sysconfig.get_paths()["include"])
     compiler = c_compiler()
-    try:
-        import Cython
-
-        cython_version = Cython.__version__
-    except ImportError:
-        cython_version = ""
+    cython_version = installed_version("Cython") or ""  # found, not imported
     why_not = ""
     if not sys.platform.startswith("linux"):
         why_not = "kernels are built on Linux only"
@@ -84,9 +80,7 @@ def kernel_plan() -> KernelPlan:
         why_not = f"no Python headers ({include}/Python.h; python3-dev)"
     if why_not:
         return KernelPlan(None, why_not, f"no kernels: {why_not}")
-    version = subprocess.run(
-        [compiler, "--version"], capture_output=True, text=True, check=False
-    ).stdout.split("\n")[0]
+    version = compiler_version(compiler)
     h = hashlib.sha256(" ".join(FLAGS).encode())
     h.update(version.encode())
     h.update(cython_version.encode())
