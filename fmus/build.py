@@ -26,7 +26,6 @@ import tempfile
 import uuid
 import zipfile
 from pathlib import Path
-from xml.dom.minidom import parseString
 from xml.etree import ElementTree as ET
 
 import pythonfmu
@@ -35,7 +34,6 @@ from pythonfmu.builder import FmuBuilder
 from components.base import Component
 from fmus.bytecode import add_bytecode
 from fmus.description import complete_description
-from fmus.documentation import render_documentation
 from fmus.host_loader import LOADER_SOURCE, loader_binary, loader_plan, pack_loader
 from fmus.input_derivatives import declare_input_derivatives
 from fmus.kernel_build import (
@@ -162,6 +160,8 @@ def _build(record: FmuRecord, digest: str, needs: list[str], tmp: Path) -> Path:
         )
     )
     (stage / "requirements.txt").write_text("".join(f"{line}\n" for line in needs))
+    from fmus.documentation import render_documentation  # only a build needs it (0.02 s)
+
     docs = tmp / "documentation"
     docs.mkdir()
     loader = loader_binary(record.name)
@@ -190,6 +190,8 @@ def _finish(
     fmu: Path, component_class: type[Component], name: str, digest: str, loader: bytes | None
 ) -> None:
     """Complete the model description, put the loader in, and write the archive anew."""
+    from xml.dom.minidom import parseString
+
     with zipfile.ZipFile(fmu) as z:
         members = {n: z.read(n) for n in z.namelist()}
     root = ET.fromstring(members["modelDescription.xml"])
