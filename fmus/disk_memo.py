@@ -17,6 +17,8 @@ import tempfile
 from pathlib import Path
 from typing import Any
 
+from fmus.cache_dir import default_cache_dir
+
 #: a memo grown past this many entries (sweeps of --set values) starts again
 MAX_ENTRIES = 20_000
 
@@ -30,8 +32,6 @@ class DiskMemo:
         self._entries: dict[str, Any] | None = None
 
     def path(self) -> Path:
-        from fmus.kernel_build import default_cache_dir
-
         return default_cache_dir() / "memo" / f"{self.name}.json"
 
     def _loaded(self) -> dict[str, Any]:

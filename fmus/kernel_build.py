@@ -23,6 +23,7 @@ from dataclasses import dataclass
 from functools import cache
 from pathlib import Path
 
+from fmus.cache_dir import default_cache_dir
 from fmus.disk_memo import installed_version
 from fmus.host_loader import c_compiler, compiler_version, say_once
 
@@ -43,15 +44,6 @@ FLAGS = (
     "-fwrapv",
     "-s",
 )
-
-
-def default_cache_dir() -> Path:
-    """Where built FMUs live: $MECHCOSIM_FMU_CACHE, else the user cache directory."""
-    env = os.environ.get("MECHCOSIM_FMU_CACHE")
-    if env:
-        return Path(env)
-    base = Path(os.environ.get("XDG_CACHE_HOME", Path.home() / ".cache"))
-    return base / "mechcosim" / "fmus"
 
 
 @dataclass(frozen=True)

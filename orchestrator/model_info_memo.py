@@ -39,7 +39,7 @@ def _code_hash() -> bytes:
 
 def _entry(path: Path) -> Path | None:
     """The memo entry of the FMU at ``path``; None if the file cannot be read."""
-    from fmus.kernel_build import default_cache_dir
+    from fmus.cache_dir import default_cache_dir
 
     try:
         data = path.read_bytes()

@@ -44,7 +44,7 @@ def ureg() -> pint.UnitRegistry:
     definition files costs 0.2-0.8 s a process, loading the cache a tenth of that. A cache
     that cannot be read (half-written by a process that died) is cleared and written again;
     one that cannot be written is passed over, and the registry built from the files."""
-    from fmus.kernel_build import default_cache_dir  # the FMU cache's location
+    from fmus.cache_dir import default_cache_dir  # the FMU cache's location
 
     pint = _pint()
     folder = default_cache_dir() / "units"
