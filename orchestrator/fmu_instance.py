@@ -8,17 +8,13 @@ logs are kept, so a failed step can say what the FMU said, and its warnings are 
 
 from __future__ import annotations
 
-import atexit
-import hashlib
 import itertools
-import shutil
 import struct
 from collections.abc import Callable
 from ctypes import byref
 from pathlib import Path
 from typing import Any
 
-from fmpy import extract, read_model_description
 from fmpy.fmi1 import FMICallException
 from fmpy.fmi2 import (  # the allocators fmpy itself hands to FMUs, and its value types
     FMU2Slave,
@@ -42,8 +38,7 @@ from fmpy.fmi2 import (  # the allocators fmpy itself hands to FMUs, and its val
 from orchestrator import flight
 from orchestrator.errors import RunError
 from orchestrator.fmu_log import FmuLog
-
-_UNPACKED: dict[str, tuple[Any, str]] = {}
+from orchestrator.unpacked_fmus import unpacked
 
 STATUS_NAMES = ("fmi2OK", "fmi2Warning", "fmi2Discard", "fmi2Error", "fmi2Fatal", "fmi2Pending")
 LAST_LINES = 3  # of an FMU's log, in the message of a call that failed
@@ -102,30 +97,6 @@ def _made_by_pythonfmu(md: Any) -> bool:
     return (md.generationTool or "").startswith("PythonFMU")
 
 
-def _unpacked(fmu_path: str) -> tuple[Any, str]:
-    """Model description and unzip directory, once per FMU file and process."""
-    if fmu_path not in _UNPACKED:
-        _UNPACKED[fmu_path] = (read_model_description(fmu_path), extract(fmu_path))
-    return _UNPACKED[fmu_path]
-
-
-@atexit.register
-def _remove_unpacked(keep: frozenset[str] = frozenset()) -> None:
-    """Remove the unzip directories, but those of the FMU files in ``keep``."""
-    for fmu_path, (_, directory) in _UNPACKED.items():
-        if fmu_path not in keep:
-            shutil.rmtree(directory, ignore_errors=True)
-
-
-def unpacked_files() -> frozenset[str]:
-    """FMU files unpacked by this process so far (a forked child shares their folders)."""
-    return frozenset(_UNPACKED)
-
-
-def file_sha256(path: Path) -> str:
-    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
-
-
 class FmuInstance:
     """An FMU instance with named access and error reporting."""
 
@@ -138,7 +109,7 @@ class FmuInstance:
         #: a master that read the values after the last such call need not read them again
         self.changes = 0
         self.moves = 0
-        md, unzip_dir = _unpacked(str(self.path))
+        md, unzip_dir = unpacked(str(self.path))
         self.model_description = md
         self.variables = {v.name: v for v in md.modelVariables}
         self.log = FmuLog()

@@ -75,7 +75,7 @@ def supervised(work: Callable[[], int], guard: SignalGuard) -> int:
 def _child(
     work: Callable[[], int], record: flight.Flight, relays: list[_Relay], parent: int
 ) -> None:
-    from orchestrator.fmu_instance import _remove_unpacked, unpacked_files
+    from orchestrator.unpacked_fmus import remove_unpacked, unpacked_files
 
     code = 1
     inherited = unpacked_files()  # the parent's, left to it
@@ -100,7 +100,7 @@ def _child(
                 stream.flush()
         record.finish(code)
         with contextlib.suppress(Exception):
-            _remove_unpacked(keep=inherited)
+            remove_unpacked(keep=inherited)
         os._exit(code)
 
 

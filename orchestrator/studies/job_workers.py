@@ -141,8 +141,8 @@ def _worker(
     run: Callable[[Job], JobResult],
 ) -> None:
     """The worker's life: jobs until its pipe closes; never returns."""
-    from orchestrator.fmu_instance import _remove_unpacked, unpacked_files
     from orchestrator.supervisor import _exit_at_once_on_exit
+    from orchestrator.unpacked_fmus import remove_unpacked, unpacked_files
 
     code = 0
     inherited = unpacked_files()  # the parent's, left to it
@@ -168,7 +168,7 @@ def _worker(
         code = 1
     finally:
         with contextlib.suppress(Exception):
-            _remove_unpacked(keep=inherited)
+            remove_unpacked(keep=inherited)
         os._exit(code)
 
 
