@@ -5,26 +5,14 @@ their own (the kernels are bound at import), and compared byte for byte."""
 
 from __future__ import annotations
 
-import contextlib
-import io
 import json
-import os
-import subprocess
-import sys
 import zipfile
 from pathlib import Path
 
 import pytest
+from kernel_paths import needs_kernels, printed_by
 
-from components.kernels import pure_python
 from fmus.build import build_fmu
-from fmus.kernel_build import kernel_plan
-
-PROJECT = Path(__file__).resolve().parents[2]
-needs_kernels = pytest.mark.skipif(
-    kernel_plan().compiler is None or pure_python(),
-    reason="no Cython or C compiler, or MECHCOSIM_PURE_PYTHON set: no compiled kernels here",
-)
 
 # One process per path: argv = scene stop ("-": no scene run), output folder, then the
 # monolithic runs as JSON keyword dictionaries.
@@ -176,22 +164,7 @@ def _run(pure: bool, stop: str, out: Path, *monolithic: dict) -> dict:
     and the scene's CSVs (stop '-': no scene run).  The Python path runs in a process of
     its own; the compiled one here, where the kernels are loaded."""
     argv = [stop, str(out), *(json.dumps(kw) for kw in monolithic)]
-    if pure:
-        env = {k: v for k, v in os.environ.items() if k != "MECHCOSIM_PURE_PYTHON"}
-        env["PYTHONPATH"] = str(PROJECT)
-        env["MECHCOSIM_PURE_PYTHON"] = "1"
-        run = subprocess.run(
-            [sys.executable, "-c", _RUN, *argv],
-            env=env,
-            capture_output=True,
-            text=True,
-            cwd=PROJECT,
-            check=False,
-        )
-        assert run.returncode == 0, run.stderr[-2000:]
-        printed = run.stdout
-    else:
-        printed = _here(argv)
+    printed = printed_by(_RUN, argv, pure, "<clock kernel run>")
     result = json.loads(printed.strip().splitlines()[-1])
     if stop != "-":
         files = ("timeseries.csv", "events.csv")
@@ -199,21 +172,6 @@ def _run(pure: bool, stop: str, out: Path, *monolithic: dict) -> dict:
         if stop != "full":
             result["cycle csv"] = {f: (out / "cycle" / f).read_bytes() for f in files}
     return result
-
-
-def _here(argv: list[str]) -> str:
-    """What _RUN prints, run in this process."""
-    saved, cwd = sys.argv, Path.cwd()
-    sys.argv = ["-c", *argv]
-    printed = io.StringIO()
-    try:
-        os.chdir(PROJECT)
-        with contextlib.redirect_stdout(printed):
-            exec(compile(_RUN, "<clock kernel run>", "exec"), {"__name__": "__kernel_run__"})
-    finally:
-        sys.argv = saved
-        os.chdir(cwd)
-    return printed.getvalue()
 
 
 @pytest.fixture(scope="module")

@@ -5,26 +5,14 @@ ends both paths with the same error at the same point."""
 
 from __future__ import annotations
 
-import contextlib
-import io
 import json
-import os
-import subprocess
-import sys
 import zipfile
 from pathlib import Path
 
 import pytest
+from kernel_paths import PROJECT, needs_kernels, printed_by
 
-from components.kernels import pure_python
 from fmus.build import build_fmu
-from fmus.kernel_build import kernel_plan
-
-PROJECT = Path(__file__).resolve().parents[2]
-needs_kernels = pytest.mark.skipif(
-    kernel_plan().compiler is None or pure_python(),
-    reason="no Cython or C compiler, or MECHCOSIM_PURE_PYTHON set: no compiled kernels here",
-)
 
 # One process per path: argv = scene (or -), its output folder, monolithic stop times.
 _RUN = """
@@ -77,52 +65,17 @@ print(json.dumps(out))
 """
 
 
-def _env(pure: bool) -> dict[str, str]:
-    env = {k: v for k, v in os.environ.items() if k != "MECHCOSIM_PURE_PYTHON"}
-    env["PYTHONPATH"] = str(PROJECT)
-    if pure:
-        env["MECHCOSIM_PURE_PYTHON"] = "1"
-    return env
-
-
 def _run(pure: bool, scene: str, out: Path, *t_stops: float) -> dict:
     """The outputs of one path: the compiled flag, the monolithic digests, the step budgets'
     outcomes and the scene's CSVs (scene '-': none; 'name.toml:full': to its end).  The
     Python path runs in a process of its own; the compiled one here, where the kernels are
     loaded (a process costs more than the runs)."""
     argv = [scene, str(out), *map(str, t_stops)]
-    if pure:
-        run = subprocess.run(
-            [sys.executable, "-c", _RUN, *argv],
-            env=_env(pure),
-            capture_output=True,
-            text=True,
-            cwd=PROJECT,
-            check=False,
-        )
-        assert run.returncode == 0, run.stderr[-2000:]
-        printed = run.stdout
-    else:
-        printed = _here(argv)
+    printed = printed_by(_RUN, argv, pure, "<compiled kernel run>")
     result = json.loads(printed.strip().splitlines()[-1])
     if scene != "-":
         result["csv"] = {f: (out / f).read_bytes() for f in ("timeseries.csv", "events.csv")}
     return result
-
-
-def _here(argv: list[str]) -> str:
-    """What _RUN prints, run in this process."""
-    saved, cwd = sys.argv, Path.cwd()
-    sys.argv = ["-c", *argv]
-    printed = io.StringIO()
-    try:
-        os.chdir(PROJECT)
-        with contextlib.redirect_stdout(printed):
-            exec(compile(_RUN, "<compiled kernel run>", "exec"), {"__name__": "__kernel_run__"})
-    finally:
-        sys.argv = saved
-        os.chdir(cwd)
-    return printed.getvalue()
 
 
 @pytest.fixture(scope="module")

@@ -6,26 +6,14 @@ ends both paths with the same error."""
 
 from __future__ import annotations
 
-import contextlib
-import io
 import json
-import os
-import subprocess
-import sys
 import zipfile
 from pathlib import Path
 
 import pytest
+from kernel_paths import needs_kernels, printed_by
 
-from components.kernels import pure_python
 from fmus.build import build_fmu
-from fmus.kernel_build import kernel_plan
-
-PROJECT = Path(__file__).resolve().parents[2]
-needs_kernels = pytest.mark.skipif(
-    kernel_plan().compiler is None or pure_python(),
-    reason="no Cython or C compiler, or MECHCOSIM_PURE_PYTHON set: no compiled kernels here",
-)
 
 #: The short runs: (scene file, overrides); a rocker reversal (0.149 s in) in each press feed
 #: run, one crank cycle where the reference is compared (it needs one).
@@ -118,13 +106,6 @@ print(json.dumps(out))
 """
 
 
-def _env() -> dict[str, str]:
-    env = {k: v for k, v in os.environ.items() if k != "MECHCOSIM_PURE_PYTHON"}
-    env["PYTHONPATH"] = str(PROJECT)
-    env["MECHCOSIM_PURE_PYTHON"] = "1"
-    return env
-
-
 def _csvs(folder: Path) -> dict[str, bytes]:
     return {
         f"{run.name}/{f}": (run / f).read_bytes()
@@ -138,37 +119,10 @@ def _run(pure: bool, out: Path, *what: str) -> dict:
     Python path runs in a process of its own; the compiled one here, where the kernels are
     loaded (a process costs more than the runs)."""
     argv = [str(out), *what]
-    if pure:
-        run = subprocess.run(
-            [sys.executable, "-c", _RUN, *argv],
-            env=_env(),
-            capture_output=True,
-            text=True,
-            cwd=PROJECT,
-            check=False,
-        )
-        assert run.returncode == 0, run.stderr[-2000:]
-        printed = run.stdout
-    else:
-        printed = _here(argv)
+    printed = printed_by(_RUN, argv, pure, "<press feed kernel run>")
     result = json.loads(printed.strip().splitlines()[-1])
     result["csv"] = _csvs(out)
     return result
-
-
-def _here(argv: list[str]) -> str:
-    """What _RUN prints, run in this process."""
-    saved, cwd = sys.argv, Path.cwd()
-    sys.argv = ["-c", *argv]
-    printed = io.StringIO()
-    try:
-        os.chdir(PROJECT)
-        with contextlib.redirect_stdout(printed):
-            exec(compile(_RUN, "<compiled kernel run>", "exec"), {"__name__": "__kernel_run__"})
-    finally:
-        sys.argv = saved
-        os.chdir(cwd)
-    return printed.getvalue()
 
 
 @pytest.fixture(scope="module")

@@ -6,38 +6,26 @@ first moments of two of them; the whole scenes run under ``slow``."""
 
 from __future__ import annotations
 
-import os
 import subprocess
 import sys
 from pathlib import Path
 
 import pytest
+from kernel_paths import PROJECT, needs_kernels, path_env
 
-from components.kernels import pure_python
-from fmus.kernel_build import kernel_plan
-
-PROJECT = Path(__file__).resolve().parents[2]
 SCENES = sorted(p.name for p in (PROJECT / "scenarios").glob("*.toml"))
 #: One scene per family with compiled physics, cut short: (scene, stop).
 #: (M739's own are in test_compiled_kernels.py; the lever's and the sprag's under slow)
 SHORT = [("clock_train_sa.toml", "4 ms"), ("press_feed_run1.toml", "0.1 s")]
-needs_kernels = pytest.mark.skipif(
-    kernel_plan().compiler is None or pure_python(),
-    reason="no Cython or C compiler, or MECHCOSIM_PURE_PYTHON set: no compiled kernels here",
-)
 
 
 def _run(scene: str, out: Path, pure: bool, stop: str | None) -> dict[str, bytes]:
-    env = {k: v for k, v in os.environ.items() if k != "MECHCOSIM_PURE_PYTHON"}
-    env["PYTHONPATH"] = str(PROJECT)
-    if pure:
-        env["MECHCOSIM_PURE_PYTHON"] = "1"
     command = [sys.executable, "-m", "orchestrator", "run", f"scenarios/{scene}"]
     command += ["--output", str(out), "--no-progress", "--no-plot", "--no-reference"]
     command += ["--force", "--in-process"]
     if stop is not None:
         command += ["--set", f"scene.stop={stop}"]
-    done = subprocess.run(command, env=env, cwd=PROJECT, capture_output=True, text=True)
+    done = subprocess.run(command, env=path_env(pure), cwd=PROJECT, capture_output=True, text=True)
     assert done.returncode == 0, f"{scene} ({'Python' if pure else 'compiled'}): {done.stderr}"
     return {f: (out / f).read_bytes() for f in ("timeseries.csv", "events.csv")}
 

@@ -1,0 +1,59 @@
+"""Running a piece of code on both kernel paths, as the compiled-kernel tests do: the
+compiled kernels here, in the test's process, where they are loaded; the Python code
+(``MECHCOSIM_PURE_PYTHON=1``) in a process of its own, since the kernels are bound when the
+physics is imported."""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from components.kernels import PURE_PYTHON_VARIABLE, pure_python
+from fmus.kernel_build import kernel_plan
+
+PROJECT = Path(__file__).resolve().parents[1]
+needs_kernels = pytest.mark.skipif(
+    kernel_plan().compiler is None or pure_python(),
+    reason="no Cython or C compiler, or MECHCOSIM_PURE_PYTHON set: no compiled kernels here",
+)
+
+
+def path_env(pure: bool) -> dict[str, str]:
+    """This environment for a process of one path, the project importable."""
+    env = {k: v for k, v in os.environ.items() if k != PURE_PYTHON_VARIABLE}
+    env["PYTHONPATH"] = str(PROJECT)
+    if pure:
+        env[PURE_PYTHON_VARIABLE] = "1"
+    return env
+
+
+def printed_by(script: str, argv: list[str], pure: bool, name: str = "<kernel run>") -> str:
+    """What ``script`` prints when run with ``argv`` on one path, from the project root."""
+    if pure:
+        run = subprocess.run(
+            [sys.executable, "-c", script, *argv],
+            env=path_env(True),
+            capture_output=True,
+            text=True,
+            cwd=PROJECT,
+            check=False,
+        )
+        assert run.returncode == 0, run.stderr[-2000:]
+        return run.stdout
+    saved, cwd = sys.argv, Path.cwd()
+    sys.argv = ["-c", *argv]
+    printed = io.StringIO()
+    try:
+        os.chdir(PROJECT)
+        with contextlib.redirect_stdout(printed):
+            exec(compile(script, name, "exec"), {"__name__": "__kernel_run__"})
+    finally:
+        sys.argv = saved
+        os.chdir(cwd)
+    return printed.getvalue()
