@@ -57,3 +57,17 @@ def printed_by(script: str, argv: list[str], pure: bool, name: str = "<kernel ru
         sys.argv = saved
         os.chdir(cwd)
     return printed.getvalue()
+
+
+def spent_budgets_alike(compiled: list, python: list) -> list:
+    """Check the outcomes of a verge run under the integration's budget (7 steps) and the
+    verge's own (40 indicator evaluations) are the same on both paths and refuse the next
+    step or evaluation with the budget's words; the third, unbounded outcome returned."""
+    assert compiled == python
+    steps, evaluations, unbounded = compiled
+    # The integration's budget: 7 steps, then the 8th is refused with the step's numbers.
+    assert steps[0] == "components.event_integration"
+    assert steps[1].startswith("spent its budget of 7 internal steps (max_internal_steps)")
+    # The verge's own budget counts indicator evaluations: 40 and the 41st is refused.
+    assert evaluations == ["components.verge_escapement", "internal step budget spent", -1]
+    return unbounded

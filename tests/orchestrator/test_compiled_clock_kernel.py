@@ -10,7 +10,7 @@ import zipfile
 from pathlib import Path
 
 import pytest
-from kernel_paths import needs_kernels, printed_by
+from kernel_paths import needs_kernels, printed_by, spent_budgets_alike
 
 from fmus.build import build_fmu
 
@@ -234,13 +234,7 @@ def test_both_paths_agree_on_the_physics_methods(short_runs: tuple[dict, dict]) 
 @needs_kernels
 def test_a_spent_step_budget_ends_both_paths_alike(short_runs: tuple[dict, dict]) -> None:
     compiled, python = short_runs
-    assert compiled["budgets"] == python["budgets"]
-    steps, evaluations, unbounded = compiled["budgets"]
-    # The integration's budget: 7 steps, then the 8th is refused with the step's numbers.
-    assert steps[0] == "components.event_integration"
-    assert steps[1].startswith("spent its budget of 7 internal steps (max_internal_steps)")
-    # The verge's own budget counts indicator evaluations: 40 and the 41st is refused.
-    assert evaluations == ["components.verge_escapement", "internal step budget spent", -1]
+    unbounded = spent_budgets_alike(compiled["budgets"], python["budgets"])
     # Without a budget the 2 ms run ends, past several events, having counted the same.
     assert unbounded[0] == "done" and unbounded[3] > 5 and 0 < unbounded[7] < 100_000
 

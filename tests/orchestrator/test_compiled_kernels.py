@@ -10,7 +10,7 @@ import zipfile
 from pathlib import Path
 
 import pytest
-from kernel_paths import PROJECT, needs_kernels, printed_by
+from kernel_paths import PROJECT, needs_kernels, printed_by, spent_budgets_alike
 
 from fmus.build import build_fmu
 
@@ -106,15 +106,9 @@ def test_both_paths_agree_on_a_short_m739_run(short_runs: tuple[dict, dict]) -> 
 @needs_kernels
 def test_a_spent_step_budget_ends_both_paths_alike(short_runs: tuple[dict, dict]) -> None:
     compiled, python = short_runs
-    assert compiled["budgets"] == python["budgets"]
-    steps, evaluations, unbounded = compiled["budgets"]
-    # The integration's budget: 7 steps, then the 8th is refused with the step's numbers.
-    assert steps[0] == "components.event_integration"
-    assert steps[1].startswith("spent its budget of 7 internal steps (max_internal_steps)")
-    # The verge's own budget counts indicator evaluations: 40 and the 41st is refused.
-    assert evaluations == ["components.verge_escapement", "internal step budget spent", -1]
-    # Without a budget the 2 ms run ends, and the count of evaluations is the same.
-    assert unbounded[0] == "done" and unbounded[4] == python["budgets"][2][4] < 100_000
+    unbounded = spent_budgets_alike(compiled["budgets"], python["budgets"])
+    # Without a budget the 2 ms run ends, some of the 100,000 evaluations spent.
+    assert unbounded[0] == "done" and 0 < unbounded[4] < 100_000
 
 
 @pytest.mark.slow
