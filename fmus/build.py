@@ -18,7 +18,6 @@ and build environment give the same file.
 from __future__ import annotations
 
 import hashlib
-import os
 import re
 import shutil
 import sys
@@ -32,6 +31,7 @@ import pythonfmu
 from pythonfmu.builder import FmuBuilder
 
 from components.base import Component
+from fmus.atomic_file import write_whole
 from fmus.bytecode import add_bytecode
 from fmus.description import complete_description
 from fmus.host_loader import LOADER_SOURCE, loader_binary, loader_plan, pack_loader
@@ -110,13 +110,8 @@ def build_fmu(name: str, cache_dir: Path | None = None, force: bool = False) -> 
         raise BuildError(str(exc)) from None
     with tempfile.TemporaryDirectory(prefix="mechcosim_build_") as tmp:
         built = _build(record, digest, needs, Path(tmp))
-        # A name of its own per builder, then an atomic rename: parallel builds of one FMU
-        # never see half a file or each other's part.
-        try:
-            fd, partial = tempfile.mkstemp(prefix=f".{name}-", suffix=".part", dir=cache_dir)
-            os.close(fd)
-            shutil.copyfile(built, partial)
-            os.replace(partial, target)
+        try:  # parallel builds of one FMU never see half a file or each other's part
+            write_whole(target, built.read_bytes())
         except OSError as exc:
             raise BuildError(f"cannot write {target}: {exc}") from None
     return target

@@ -12,11 +12,10 @@ from __future__ import annotations
 
 import importlib.util
 import json
-import os
-import tempfile
 from pathlib import Path
 from typing import Any
 
+from fmus.atomic_file import write_whole
 from fmus.cache_dir import default_cache_dir
 
 #: a memo grown past this many entries (sweeps of --set values) starts again
@@ -52,14 +51,8 @@ class DiskMemo:
         if len(entries) >= MAX_ENTRIES:
             entries.clear()
         entries[key] = value
-        path = self.path()
         try:
-            path.parent.mkdir(parents=True, exist_ok=True)
-            # a file of its own, then an atomic rename: readers never see half a memo
-            fd, partial = tempfile.mkstemp(prefix=f".{self.name}-", suffix=".part", dir=path.parent)
-            with os.fdopen(fd, "w") as f:
-                json.dump(entries, f)
-            os.replace(partial, path)
+            write_whole(self.path(), json.dumps(entries).encode())
         except OSError:
             pass  # an unwritable cache: worked out again next time
 

@@ -13,7 +13,6 @@ a compiler the build says so in one line and the Python code runs.
 from __future__ import annotations
 
 import hashlib
-import os
 import shutil
 import subprocess
 import sys
@@ -23,6 +22,7 @@ from dataclasses import dataclass
 from functools import cache
 from pathlib import Path
 
+from fmus.atomic_file import write_whole
 from fmus.cache_dir import default_cache_dir
 from fmus.disk_memo import installed_version
 from fmus.host_loader import c_compiler, compiler_version, say_once
@@ -156,12 +156,7 @@ def kernel_library(name: str, cache_dir: Path | None = None) -> Path | None:
     if binary is None:
         return None
     try:
-        target.parent.mkdir(parents=True, exist_ok=True)
-        # a name of its own, then an atomic rename: parallel builders never see half a file
-        fd, partial = tempfile.mkstemp(prefix=f".{name}-", suffix=".part", dir=target.parent)
-        with os.fdopen(fd, "wb") as f:
-            f.write(binary)
-        os.replace(partial, target)
+        write_whole(target, binary)  # parallel builders never see half a file
     except OSError as exc:
         say_once(f"kernel {name}: cannot write {target} ({exc}): the physics runs as Python code")
         return None

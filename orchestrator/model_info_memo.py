@@ -12,13 +12,13 @@ from __future__ import annotations
 
 import contextlib
 import hashlib
-import os
 import pickle
-import tempfile
 from dataclasses import replace
 from functools import cache
 from pathlib import Path
 from typing import Any
+
+from fmus.atomic_file import write_whole
 
 _ROOT = Path(__file__).resolve().parent.parent
 _CODE = (
@@ -67,14 +67,5 @@ def remember(path: Path, info: Any) -> None:
     entry = _entry(path)
     if entry is None:
         return
-    tmp = None
-    try:
-        entry.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(dir=entry.parent, suffix=".tmp")
-        with os.fdopen(fd, "wb") as f:
-            pickle.dump(info, f, protocol=pickle.HIGHEST_PROTOCOL)
-        os.replace(tmp, entry)
-    except (OSError, pickle.PicklingError, TypeError, AttributeError):
-        if tmp is not None:
-            with contextlib.suppress(OSError):
-                os.unlink(tmp)
+    with contextlib.suppress(OSError, pickle.PicklingError, TypeError, AttributeError):
+        write_whole(entry, pickle.dumps(info, protocol=pickle.HIGHEST_PROTOCOL))

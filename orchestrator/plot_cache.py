@@ -13,14 +13,13 @@ from __future__ import annotations
 import contextlib
 import hashlib
 import json
-import os
 import shutil
-import tempfile
 from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
 
+from fmus.atomic_file import write_whole
 from fmus.disk_memo import installed_version
 from orchestrator.reference_cache import code_hash, scene_content
 from orchestrator.scene_model import Scene
@@ -83,16 +82,5 @@ def plot_key(scene: Scene, header: list[str], data: np.ndarray, path: Path) -> s
 
 def _keep(drawn: Path, kept: Path) -> None:
     """Copy the drawn plot into the cache (whole, then renamed); not kept if it cannot be."""
-    if not drawn.is_file():
-        return
-    tmp = None
-    try:
-        kept.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(dir=kept.parent, suffix=".tmp")
-        os.close(fd)
-        shutil.copyfile(drawn, tmp)
-        os.replace(tmp, kept)
-    except OSError:
-        if tmp is not None:
-            with contextlib.suppress(OSError):
-                os.unlink(tmp)
+    with contextlib.suppress(OSError):  # none drawn, or a cache that cannot take it
+        write_whole(kept, drawn.read_bytes())

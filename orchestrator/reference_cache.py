@@ -10,16 +10,13 @@ again; any change to one of those misses.  Deleting the folder clears the cache.
 
 from __future__ import annotations
 
-import contextlib
 import hashlib
 import importlib
 import json
 import marshal
-import os
 import pickle
 import re
 import sys
-import tempfile
 import types
 from collections.abc import Callable
 from dataclasses import replace
@@ -27,6 +24,7 @@ from functools import cache
 from pathlib import Path
 from typing import Any
 
+from fmus.atomic_file import write_whole
 from orchestrator.scene_model import Scene
 from orchestrator.scenes.family import Reference
 
@@ -142,16 +140,9 @@ def _write(path: Path, ref: Reference) -> None:
             "reference": replace(ref, signals=None),
             "signals": _function_state(ref.signals),
         }
-        data = pickle.dumps(stored, protocol=pickle.HIGHEST_PROTOCOL)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".tmp")
-        with os.fdopen(fd, "wb") as f:
-            f.write(data)
-        os.chmod(tmp, 0o666 & ~_umask())  # as any file written here (mkstemp's is 0600)
-        os.replace(tmp, path)
+        write_whole(path, pickle.dumps(stored, protocol=pickle.HIGHEST_PROTOCOL))
     except Exception:  # noqa: BLE001 - the cache only saves time: the run goes on without
-        with contextlib.suppress(Exception):
-            os.unlink(tmp)  # type: ignore[possibly-undefined]
+        pass
 
 
 def _function_state(fn: Callable) -> dict[str, Any]:
@@ -174,9 +165,3 @@ def _function(state: dict[str, Any]) -> Callable:
     return types.FunctionType(
         marshal.loads(state["code"]), module.__dict__, state["name"], state["defaults"], closure
     )
-
-
-def _umask() -> int:
-    mask = os.umask(0)
-    os.umask(mask)
-    return mask

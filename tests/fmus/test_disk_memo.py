@@ -69,3 +69,24 @@ def test_installed_versions_are_those_of_the_distributions(
     monkeypatch.setattr(disk_memo, "_VERSIONS", DiskMemo("installed-versions"))
     assert disk_memo.installed_version("numpy") == metadata.version("numpy")
     assert any(k.startswith("numpy\x1f") for k in disk_memo._VERSIONS._loaded())
+
+
+def test_a_file_is_written_whole_or_not_at_all(tmp_path: Path) -> None:
+    from fmus.atomic_file import write_whole
+
+    target = tmp_path / "sub" / "f.bin"
+    write_whole(target, b"one")
+    write_whole(target, b"two")  # over the first
+    assert target.read_bytes() == b"two"
+    assert target.stat().st_mode & 0o777 == 0o666 & ~_umask()  # not mkstemp's 0600
+    with pytest.raises(OSError):
+        write_whole(tmp_path / "sub", b"x")  # a folder is there: refused
+    assert sorted(p.name for p in (tmp_path / "sub").iterdir()) == ["f.bin"]  # no part left
+
+
+def _umask() -> int:
+    import os
+
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
