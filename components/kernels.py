@@ -26,6 +26,15 @@ def pure_python() -> bool:
     return os.environ.get(PURE_PYTHON_VARIABLE, "").strip() not in ("", "0")
 
 
+def path_environment(pure: bool) -> dict[str, str]:
+    """This process's environment for a process of one path: the Python code's
+    (``MECHCOSIM_PURE_PYTHON=1``) or the compiled kernels' (the variable removed)."""
+    env = {k: v for k, v in os.environ.items() if k != PURE_PYTHON_VARIABLE}
+    if pure:
+        env[PURE_PYTHON_VARIABLE] = "1"
+    return env
+
+
 def load_kernel(name: str) -> ModuleType | None:
     """The compiled kernel ``name``, or None where there is none (or the Python code is
     asked for): the caller then keeps its Python functions."""

@@ -142,7 +142,7 @@ def _build(record: FmuRecord, digest: str, needs: list[str], tmp: Path) -> Path:
     for module in modules:
         shutil.copy2(module, code / "components")
     for kernel in _kernels(modules):  # beside the Python code; without it that code runs
-        binary = compiled_kernel(kernel, kernel_identity(kernel))
+        binary = compiled_kernel(kernel)
         if binary is not None:
             (code / "components" / f"{kernel}.so").write_bytes(binary)
     script = stage / f"{record.script.stem}_{digest}.py"

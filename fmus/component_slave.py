@@ -157,7 +157,7 @@ class ComponentSlave(Fmi2Slave):
         self._readers: dict[str, dict[tuple[int, ...], Any]] = {"Real": {}, "Integer": {}}
         # value references set -> their names and the positions of those some output
         # depends on (None: a reference given twice, set one after the other)
-        self._set_plans: dict[tuple[int, ...], tuple[tuple[str, ...], tuple[int, ...]] | None]
+        self._set_plans: dict[tuple[int, ...], tuple[tuple[str, ...], tuple[int, ...]]]
         self._set_plans = {}
 
     def _register(self, var: Any) -> None:
@@ -406,48 +406,39 @@ class ComponentSlave(Fmi2Slave):
             self._feedthrough_stale = self._init_stale = self._outputs_stale = True
             return
         key = tuple(vrs)
-        plan = self._set_plans.get(key, _NO_PLAN)
-        if plan is _NO_PLAN:
+        if len(values) != len(key):
+            raise ValueError(f"{len(key)} references but {len(values)} values")
+        plan = self._set_plans.get(key)
+        if plan is None:
             plan = self._set_plan(key)
+        set_names, feeding = plan
+        values = list(map(cast, values))
         stale = self._outputs_stale
-        from_inputs = self._outputs_from_inputs
-        if plan is None or len(values) != len(key):
-            feeds = self._feeds_outputs
-            for vr, value in zip(vrs, values, strict=True):
-                name = names[vr]
-                value = cast(value)
-                if not stale and vr in feeds:
-                    # after a step the outputs are the step's: a set recomputes them, as ever
-                    stale = not from_inputs or not _same(getattr(comp, name), value)
-                setattr(comp, name, value)
-        else:
-            set_names, feeding = plan
-            values = list(map(cast, values))
-            if not stale and feeding:
-                # after a step the outputs are the step's: a set recomputes them, as ever
-                stale = not from_inputs
-                for k in () if stale else feeding:
-                    if not _same(getattr(comp, set_names[k]), values[k]):
-                        stale = True
-                        break
-            for name, value in zip(set_names, values, strict=True):
-                setattr(comp, name, value)
+        if not stale and feeding:
+            # after a step the outputs are the step's: a set recomputes them, as ever.  A
+            # reference given twice is compared with the value before the call each time:
+            # stale as soon as either differs, as when compared one set after the other.
+            stale = not self._outputs_from_inputs
+            for k in () if stale else feeding:
+                if not _same(getattr(comp, set_names[k]), values[k]):
+                    stale = True
+                    break
+        for name, value in zip(set_names, values, strict=True):  # the last of a twice-set wins
+            setattr(comp, name, value)
         self._feedthrough_stale = self._init_stale = True
         self._outputs_stale = stale
 
-    def _set_plan(self, vrs: tuple[int, ...]) -> tuple[tuple[str, ...], tuple[int, ...]] | None:
+    def _set_plan(self, vrs: tuple[int, ...]) -> tuple[tuple[str, ...], tuple[int, ...]]:
         """The names of ``vrs`` (valid, settable ones) and the positions of those some
         output depends on; kept for the next set of the same references."""
         plans = self._set_plans
         if len(plans) >= READERS_KEPT:  # a host setting ever other lists: no unbounded memo
             plans.clear()
-        plan = None
-        if len(set(vrs)) == len(vrs):
-            feeds = self._feeds_outputs
-            plan = (
-                tuple(self._names[vr] for vr in vrs),
-                tuple(k for k, vr in enumerate(vrs) if vr in feeds),
-            )
+        feeds = self._feeds_outputs
+        plan = (
+            tuple(self._names[vr] for vr in vrs),
+            tuple(k for k, vr in enumerate(vrs) if vr in feeds),
+        )
         plans[vrs] = plan
         return plan
 
@@ -499,7 +490,6 @@ class ComponentSlave(Fmi2Slave):
 #: Reading functions kept per type (one per list of value references a host asks for), and
 #: setting plans.
 READERS_KEPT = 64
-_NO_PLAN = object()
 
 
 def _same(old: float, new: float) -> bool:

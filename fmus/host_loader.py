@@ -27,6 +27,8 @@ from dataclasses import dataclass
 from functools import cache
 from pathlib import Path
 
+from fmus.disk_memo import DiskMemo
+
 LOADER_SOURCE = Path(__file__).resolve().parent / "loader" / "python_loader.c"
 #: pythonfmu's runtime inside the FMU, beside the loader
 RUNTIME_FILE = "libpythonfmu-export.so"
@@ -75,21 +77,22 @@ def c_compiler() -> str | None:
     return None
 
 
+#: compiler file and date -> its version line
+_COMPILER_VERSIONS = DiskMemo("compiler-versions")
+
+
 def compiler_version(compiler: str) -> str:
     """The first line of ``compiler --version``, kept in a memo keyed by the compiler's
     file and its date (``fmus.disk_memo``): asking it cost a process 5-10 ms a plan."""
-    from fmus.disk_memo import DiskMemo
-
     real = Path(compiler).resolve()
     key = f"{real}\x1f{real.stat().st_mtime_ns}"
-    memo = DiskMemo("compiler-versions")
-    known = memo.get(key)
+    known = _COMPILER_VERSIONS.get(key)
     if isinstance(known, str):
         return known
     version = subprocess.run(
         [compiler, "--version"], capture_output=True, text=True, check=False
     ).stdout.split("\n")[0]
-    memo.put(key, version)
+    _COMPILER_VERSIONS.put(key, version)
     return version
 
 

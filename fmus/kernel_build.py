@@ -89,14 +89,14 @@ def kernel_identity(name: str) -> str:
     return h.hexdigest()
 
 
-def compiled_kernel(name: str, identity: str) -> bytes | None:
+def compiled_kernel(name: str) -> bytes | None:
     """The kernel's shared library: from the FMU cache's ``kernels/``, built there if
     missing (one compilation serves every process that builds FMUs); None (said in one
     line) where it cannot be built."""
     library = kernel_library(name)
     if library is not None:
         return library.read_bytes()
-    return _compiled(name, identity)
+    return _compiled(name, kernel_identity(name))
 
 
 @cache

@@ -19,6 +19,7 @@ from pathlib import Path
 from typing import Any
 
 from fmus.atomic_file import write_whole
+from orchestrator.file_hash import file_sha256
 
 _ROOT = Path(__file__).resolve().parent.parent
 _CODE = (
@@ -42,7 +43,7 @@ def _entry(path: Path) -> Path | None:
     from fmus.cache_dir import default_cache_dir
 
     try:
-        data = path.read_bytes()
+        data = file_sha256(path).encode()  # hashed once a process, for the run's summary too
     except OSError:
         return None  # said by the reading itself
     key = hashlib.sha256(_code_hash() + data).hexdigest()[:32]

@@ -25,6 +25,7 @@ from pathlib import Path
 from typing import Any
 
 from fmus.atomic_file import write_whole
+from orchestrator.file_hash import file_sha256
 from orchestrator.scene_model import Scene
 from orchestrator.scenes.family import Reference
 
@@ -117,7 +118,7 @@ def _family_files(family: str) -> list[Path]:
 
 def _file_hash(path: Path) -> str:
     try:
-        return hashlib.sha256(path.read_bytes()).hexdigest()
+        return file_sha256(path)
     except OSError:
         return "missing"
 

@@ -25,6 +25,7 @@ from orchestrator.accuracy import compare
 from orchestrator.analyses import energy_residual, headline, missing_column
 from orchestrator.errors import RunError
 from orchestrator.execution import StopRule, execute
+from orchestrator.file_hash import file_sha256
 from orchestrator.flight import announce_run, summary_written
 from orchestrator.fmu_instance import FmuTerminated
 from orchestrator.fmu_log import FmuLog
@@ -48,7 +49,6 @@ from orchestrator.signals import scene_signals
 from orchestrator.stop_condition import keep_comparable, refuse_if_met_at_start
 from orchestrator.summary_file import not_started_summary, write_summary
 from orchestrator.system import CoupledSystem
-from orchestrator.unpacked_fmus import file_sha256
 
 
 @dataclass(kw_only=True)

@@ -25,8 +25,6 @@ from orchestrator.regular_files import CSV_LIMIT, SUMMARY_LIMIT, NotARegularFile
 
 RUNNING = "running"
 INCOMPLETE = "incomplete"
-#: Bytes read from the end of a series for its last row.
-_TAIL = 1 << 16
 
 
 class NotARunDirectory(RunError):

@@ -50,6 +50,7 @@ from orchestrator.scene_model import (
 )
 from orchestrator.scenes import ANALYSES, FAMILY_NAMES, REFERENCES, family, shared_parameters
 from orchestrator.scenes.family import Option, SharedParameter
+from orchestrator.setting_limits import MAX_RUN_STEPS as MAX_STEPS
 from orchestrator.signals import (
     Reader,
     Signal,
@@ -65,9 +66,6 @@ from orchestrator.units import to_si
 RECORDED_TYPES = ("Real", "Integer", "Enumeration", "Boolean")
 
 REDUCTIONS = ("final", "initial", "max", "min", "maxabs", "mean")
-
-#: More macro steps than this cannot finish in any sensible time: refused unless forced.
-MAX_STEPS = 1e8
 
 #: What each master's step key sets (its message when the scene gives none).
 STEP_MEANING = {

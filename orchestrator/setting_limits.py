@@ -18,7 +18,8 @@ from orchestrator.master_settings import MAX_TOLERANCE, MIN_TOLERANCE
 MAX_WORKERS = 256
 #: The fewest samples of a study: a standard deviation needs two.
 MIN_SAMPLES = 2
-#: Macro steps one run of a sweep may take (scenario.MAX_STEPS, the scene's own limit).
+#: Macro steps one run may take, a scene's (orchestrator.scenario) and a sweep's alike:
+#: more cannot finish in any sensible time, and are refused unless forced.
 MAX_RUN_STEPS = 1e8
 
 

@@ -210,14 +210,19 @@ class CoupledSystem:
     def read(self, i: int) -> None:
         if self.held_back and i in self.held_back:
             return  # its values stay those of the step start until its own step
+        self._read(i)
+
+    def _read(self, i: int, kinds: tuple[bool, bool, bool] = (True, True, True)) -> None:
+        """Read instance i's Real, Integer and Boolean values, those of ``kinds``."""
+        reals, ints, bools = kinds
         get = self._get_reals[i]
-        if get is not None:
+        if reals and get is not None:
             self.values[i] = get()
         get = self._get_ints[i]
-        if get is not None:
+        if ints and get is not None:
             self.ints[i] = get()
         get = self._get_bools[i]
-        if get is not None:
+        if bools and get is not None:
             self.bools[i] = get()
         inst = self.instances[i]
         self._read_at[i] = (inst.changes, inst.moves)
@@ -232,19 +237,8 @@ class CoupledSystem:
         if at is None or at[1] != inst.moves:
             self.read(i)
             return
-        if at[0] == inst.changes:
-            return
-        reals, ints, bools = self._dependent_kinds[i]
-        get = self._get_reals[i]
-        if reals and get is not None:
-            self.values[i] = get()
-        get = self._get_ints[i]
-        if ints and get is not None:
-            self.ints[i] = get()
-        get = self._get_bools[i]
-        if bools and get is not None:
-            self.bools[i] = get()
-        self._read_at[i] = (inst.changes, inst.moves)
+        if at[0] != inst.changes:
+            self._read(i, self._dependent_kinds[i])
 
     def input_dependent(self) -> list[int]:
         """The instances some of whose read values may change when their inputs are set (an
@@ -295,6 +289,9 @@ class CoupledSystem:
         inputs from ``ints``, values read like ``self.ints``, when given)."""
         if self.held_back and i in self.held_back:
             return  # fed the step start's values at its own step
+        self._feed(i, reals, ints)
+
+    def _feed(self, i: int, reals: list[float] | None, ints: list[list[int]] | None) -> None:
         feed = self.feeds[i]
         # Values equal to those the FMU holds are not set again: a set makes our FMUs
         # recompute their outputs, and a step's held inputs are often the ones the exchange
@@ -320,6 +317,9 @@ class CoupledSystem:
         if self.held_back and i in self.held_back:
             self.skipped_steps += 1
             return
+        self._do_step(i, t, h)
+
+    def _do_step(self, i: int, t: float, h: float) -> None:
         drive = self._drive
         if drive is None:
             self.instances[i].do_step(t, h)
@@ -434,27 +434,10 @@ class CoupledSystem:
         stepped."""
         held = sorted(self.held_back)
         for i in held:
-            feed, restores = self.feeds[i], self.instances[i].restores
-            if self._set_reals[i] is not None:
-                reals = [values[s][k] for s, k in feed.real_sources]
-                self._set_reals[i](reals)
-                self._fed_reals[i] = (restores, reals)
-            if self._set_ints[i] is not None:
-                given = [ints[s][k] for s, k in feed.int_sources]
-                self._set_ints[i](given)
-                self._fed_ints[i] = (restores, given)
-            drive = self._drive
-            if drive is not None:
-                drive(i, t)
-            self.instances[i].do_step(t, h)
-            if drive is not None:
-                drive(i, t + h)
-        self.held_back = set()  # read as any other
-        try:
-            for i in held:
-                self.read(i)
-        finally:
-            self.held_back = set(held)
+            self._feed(i, [values[s][k] for s, k in self.feeds[i].real_sources], ints)
+            self._do_step(i, t, h)
+        for i in held:
+            self._read(i)
         return held
 
     def restore_faults(self, t: float, h: float) -> dict[str, str]:

@@ -14,34 +14,21 @@ from __future__ import annotations
 
 import atexit
 import contextlib
-import hashlib
 import os
 import shutil
 import tempfile
-from functools import cache
 from pathlib import Path
 from typing import Any
 
 from fmpy import extract, read_model_description
 
 from fmus.cache_dir import default_cache_dir
+from orchestrator.file_hash import file_sha256
 
 #: FMU file -> (model description, unzip folder), once per process
 _UNPACKED: dict[str, tuple[Any, str]] = {}
 #: the FMU files whose folders are kept in the FMU cache (never removed here)
 _KEPT: set[str] = set()
-
-
-def file_sha256(path: Path) -> str:
-    """The file's SHA-256 (kept per file version in the process: a run hashes its FMUs for
-    its folders and again for its summary)."""
-    stat = Path(path).stat()
-    return _sha256(Path(path), stat.st_mtime_ns, stat.st_size)
-
-
-@cache
-def _sha256(path: Path, mtime_ns: int, size: int) -> str:
-    return hashlib.sha256(path.read_bytes()).hexdigest()
 
 
 def unpacked(fmu_path: str) -> tuple[Any, str]:

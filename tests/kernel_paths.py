@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pytest
 
-from components.kernels import PURE_PYTHON_VARIABLE, pure_python
+from components.kernels import path_environment, pure_python
 from fmus.kernel_build import kernel_plan
 
 PROJECT = Path(__file__).resolve().parents[1]
@@ -26,11 +26,7 @@ needs_kernels = pytest.mark.skipif(
 
 def path_env(pure: bool) -> dict[str, str]:
     """This environment for a process of one path, the project importable."""
-    env = {k: v for k, v in os.environ.items() if k != PURE_PYTHON_VARIABLE}
-    env["PYTHONPATH"] = str(PROJECT)
-    if pure:
-        env[PURE_PYTHON_VARIABLE] = "1"
-    return env
+    return {**path_environment(pure), "PYTHONPATH": str(PROJECT)}
 
 
 def printed_by(script: str, argv: list[str], pure: bool, name: str = "<kernel run>") -> str:

@@ -136,8 +136,8 @@ def _read_series(path: Path) -> tuple[list[str], np.ndarray]:
 
 def _scene_as_run(path: Path, meta: dict[str, Any], summary_file: Path) -> tuple[Any, list[str]]:
     """The scene file, loaded, with each FMU's parameters replaced by those it ran with."""
+    from orchestrator.file_hash import file_sha256
     from orchestrator.scenario import load_scene
-    from orchestrator.unpacked_fmus import file_sha256
 
     if not path.is_file():
         raise ScenarioError(

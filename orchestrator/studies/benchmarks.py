@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import json
 import math
-import os
 import statistics
 import subprocess
 import sys
@@ -20,6 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
+from components.kernels import path_environment
 from components.rotational import Inertia, SpringDamperInertia
 from fmus.build import build_fmu
 from orchestrator.fmu_instance import FmuInstance
@@ -484,9 +484,7 @@ def _kernel_process(
 ) -> dict[str, object]:
     """kernel_timings in a process of its own (the kernels are bound when the physics is
     imported, so the two paths need two processes)."""
-    env = {k: v for k, v in os.environ.items() if k != "MECHCOSIM_PURE_PYTHON"}
-    if pure:
-        env["MECHCOSIM_PURE_PYTHON"] = "1"
+    env = path_environment(pure)
     code = (
         "import json; from orchestrator.studies.benchmarks import kernel_timings; "
         f"print(json.dumps(kernel_timings(scene_file={scene_file!r}, kernel={kernel!r})))"

@@ -8,13 +8,14 @@ time is measured as a user sees it: the whole command, worker start-up and all.
 
 from __future__ import annotations
 
-import os
 import statistics
 import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
+
+from components.kernels import path_environment
 
 PROJECT = Path(__file__).resolve().parents[2]
 SCENE = PROJECT / "scenarios" / "m739_study.toml"
@@ -25,9 +26,7 @@ ROUNDS = 2
 
 def _study(pure: bool, out: Path, samples: int = SAMPLES) -> float:
     """Wall time [s] of one study command, its samples written under ``out``."""
-    env = {k: v for k, v in os.environ.items() if k != "MECHCOSIM_PURE_PYTHON"}
-    if pure:
-        env["MECHCOSIM_PURE_PYTHON"] = "1"
+    env = path_environment(pure)
     command = [sys.executable, "-m", "orchestrator", "study", str(SCENE)]
     command += ["--samples", str(samples), "--workers", str(WORKERS), "--no-progress"]
     command += ["--output", str(out)]

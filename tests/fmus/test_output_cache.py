@@ -130,3 +130,20 @@ def test_a_restored_state_brings_its_outputs_state(monkeypatch: pytest.MonkeyPat
     s.set_real([a], [1.0])
     assert s.get_real([y]) == [3.0]
     assert Counted.updates == 1
+
+
+def test_a_reference_set_twice_in_one_call_keeps_the_last(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    s = _slave(Counted, monkeypatch)
+    a, y = _vr(s, "a"), _vr(s, "y")
+    assert s.get_real([y]) == [3.0]
+    Counted.updates = 0
+    s.set_real([a, a], [1.0, 4.0])  # the held value first, a new one second: recomputed
+    assert s.get_real([y]) == [12.0]
+    assert Counted.updates == 1
+    s.set_real([a, a], [4.0, 4.0])  # the value held, twice: nothing to recompute
+    assert s.get_real([y]) == [12.0]
+    assert Counted.updates == 1
+    with pytest.raises(ValueError, match="2 references but 1 values"):
+        s._set([a, a], [1.0], float)
