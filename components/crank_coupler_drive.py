@@ -36,14 +36,10 @@ from .base import (
 from .coupler_inertia import computed_inertia
 from .design_rules import raise_first
 from .event_integration import (
-    Advanced,
-    IntegrationStepControl,
-    StepBudgetSpent,
-    _fire_at_instant,
-    _first_step,
     advance,
     integration_step_control,
     integration_variables,
+    use_compiled_loop,
 )
 from .kernels import load_kernel
 from .press_feed_data import (
@@ -529,7 +525,7 @@ class CrankCouplerDrive(Component):
             m, self.torque, 1.0 if forward else -1.0, self.torque_rate, phi1 + 0.5 * m.omega * h
         )
         y = [phi1, self.q, self.q_dot, self.input_work, self.dissipated_work]
-        done = _advance(motion, y, h, self._control, self._h_next)
+        done = advance(motion, y, h, self._control, self._h_next)
         self._h_next = done.h_next
         if done.events:
             self.event_time = t + done.t_last_event
@@ -538,22 +534,6 @@ class CrankCouplerDrive(Component):
         self.input_work, self.dissipated_work = wi, wd
         self._t = t + h
         self.update_outputs()
-
-
-def _advance(
-    motion: _CouplerMotion,
-    y: list[float],
-    h: float,
-    control: IntegrationStepControl,
-    h_try: float,
-) -> Advanced:
-    """event_integration.advance over one step: compiled where the kernel knows the
-    drive's rocker model, else the Python loop."""
-    if _KERNEL is not None:
-        done = _KERNEL.coupler_advance(motion, y, h, control, h_try)
-        if done is not None:
-            return done
-    return advance(motion, y, h, control, h_try)
 
 
 _KERNEL = load_kernel("press_feed_kernel")
@@ -565,8 +545,8 @@ if _KERNEL is not None:  # the compiled twins (components.kernels): the same res
         deriv=_CouplerMotion.deriv,
         indicators=_CouplerMotion.indicators,
     )
-    _KERNEL.use_classes(coupler_motion=_CouplerMotion, advanced=Advanced)
-    _KERNEL.use_integration(ComponentError, StepBudgetSpent, _fire_at_instant, _first_step)
+    _KERNEL.use_classes(coupler_motion=_CouplerMotion)
+    use_compiled_loop(_KERNEL)  # event_integration.advance runs the drive's model in C
     coupler_derivatives = _KERNEL.coupler_derivatives  # noqa: F811
     rocker_motion = _KERNEL.rocker_motion  # noqa: F811
     rocker_angles = _KERNEL.rocker_angles  # noqa: F811

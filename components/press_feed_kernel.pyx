@@ -96,8 +96,7 @@ cdef int STICK = 0, SLIP_FORWARD = 1, SLIP_BACKWARD = 2
 
 def use_classes(**classes):
     """The classes the compiled code recognises (by role): exact, fourier (the rocker
-    models), coupler_motion (the drive's model over a step), advanced (advance's result),
-    nonlinear (the monolithic reference's machine)."""
+    models), coupler_motion (the drive's model over a step), nonlinear (the monolithic reference's machine)."""
     CLASSES.update(classes)
 
 
@@ -580,13 +579,13 @@ cdef class _CouplerRun:
         return [Y[i] for i in range(NY)], t_first, t_event, n_events, h_next, steps, rejected
 
 
-def coupler_advance(motion, y, double h_total, control, double h_try=0.0,
-                    double tol_t=1e-14, long max_events=2000):
-    """event_integration.advance compiled for the drive's _CouplerMotion (the result as an
-    event_integration.Advanced); None for any other model or rocker (the Python loop runs
-    it)."""
+def advance(motion, y, double h_total, control, double h_try, double tol_t, long max_events,
+            observe):
+    """event_integration.advance's loop compiled for the drive's _CouplerMotion (registered
+    with its use_compiled_loop): Advanced's fields; None for any other model or rocker, or
+    with an observer (the Python loop runs it)."""
     cdef _CouplerRun run
-    if type(motion) is not CLASSES["coupler_motion"] or len(y) != NY:
+    if observe is not None or type(motion) is not CLASSES["coupler_motion"] or len(y) != NY:
         return None
     if len(control.scales) > NY or not _known(motion.m):
         return None
@@ -595,7 +594,7 @@ def coupler_advance(motion, y, double h_total, control, double h_try=0.0,
     run.d = DRIVE
     run.torque, run.rate, run.phi1_mid = motion.torque, motion.rate, motion.phi1_mid
     run.direction = motion.direction  # changed only by its events, read back after each
-    return CLASSES["advanced"](*run.run(y, h_total, control, h_try, tol_t, max_events))
+    return run.run(y, h_total, control, h_try, tol_t, max_events)
 
 
 def coupler_motion_deriv(self, y):

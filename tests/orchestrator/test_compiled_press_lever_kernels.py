@@ -33,8 +33,8 @@ import hashlib, json, sys
 from pathlib import Path
 import numpy as np
 from components.crank_coupler_drive import (
-    STATE_SCALES, _advance, _CouplerMotion, build_drive_model)
-from components.event_integration import IntegrationStepControl, StepBudgetSpent
+    STATE_SCALES, _CouplerMotion, build_drive_model)
+from components.event_integration import IntegrationStepControl, StepBudgetSpent, advance
 from components.kernels import load_kernel
 from components.press_feed_data import LINKAGE_TABLE1
 from components.rssr_kinematics import ExactRSSR
@@ -79,7 +79,7 @@ if sys.argv[2] == "short":
     m = build_drive_model(200.0)
     control = IntegrationStepControl(1e-10, STATE_SCALES, 1e-3, max_steps=3)
     try:
-        _advance(_CouplerMotion(m, 5.0, 1.0, 10.0, 0.1), [0.1, 0.0, 0.0, 0.0, 0.0], 0.05,
+        advance(_CouplerMotion(m, 5.0, 1.0, 10.0, 0.1), [0.1, 0.0, 0.0, 0.0, 0.0], 0.05,
                  control, 0.0)
         out["budget"] = ["done"]
     except StepBudgetSpent as exc:
@@ -93,7 +93,7 @@ if sys.argv[2] == "short":
                 out["kinematics"].append(exact(kin(k * 0.2618)))
             except (ArithmeticError, ValueError) as exc:
                 out["kinematics"].append([type(exc).__name__, str(exc)])
-    done = _advance(_CouplerMotion(m, 5.0, 1.0, 10.0, 0.1), [0.1, 0.0, 0.0, 0.0, 0.0], 0.3,
+    done = advance(_CouplerMotion(m, 5.0, 1.0, 10.0, 0.1), [0.1, 0.0, 0.0, 0.0, 0.0], 0.3,
                     IntegrationStepControl(1e-8, STATE_SCALES, 1e-3), 0.0)
     out["advance"] = repr(tuple(done))
 else:
