@@ -17,6 +17,8 @@ import tempfile
 import time
 from pathlib import Path
 
+from orchestrator.studies.timing import print_targets
+
 PROJECT = Path(__file__).resolve().parents[2]
 SCENE = "scenarios/m739.toml"
 ROUNDS = 5
@@ -66,8 +68,4 @@ def answer_rows() -> list[tuple[str, float, str]]:
 
 
 def print_answer_time() -> None:
-    rows = answer_rows()
-    width = max(len(what) for what, _, _ in rows)
-    print(f"\n{'ratio':{width}s} {'measured':>9s} {'target':>7s}")
-    for what, value, target in rows:
-        print(f"{what:{width}s} {value:9.2f} {target:>7s}")
+    print_targets(answer_rows())

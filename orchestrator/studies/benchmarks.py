@@ -29,7 +29,7 @@ from orchestrator.scenes.family import Headline, Outcome
 from orchestrator.studies.jobs import JobResult, run_job, run_jobs
 from orchestrator.studies.monolithic_curve import TRUTH_TOLERANCE, monolithic_model
 from orchestrator.studies.parameter_sweep import sweep_jobs
-from orchestrator.studies.timing import SCENARIOS, best_per_call
+from orchestrator.studies.timing import SCENARIOS, best_per_call, print_targets
 
 
 def overhead(n: int = 20000) -> dict[str, float]:
@@ -555,11 +555,12 @@ def speed() -> None:
     Truths: the monolithic models at tolerance 1e-12.  The monolithic time is that of the
     loosest tolerance whose turns error is within the same budget as the co-simulation's.
     """
+    from orchestrator.studies.answer_time import answer_rows
+    from orchestrator.studies.study_speed import study_rows
+
     rows = _kernel_rows() + _monolithic_rows() + _press_feed_rows() + _sweep_throughput()
-    width = max(len(what) for what, _, _ in rows)
-    print(f"\n{'ratio':{width}s} {'measured':>9s} {'target':>7s}")
-    for what, ratio, target in rows:
-        print(f"{what:{width}s} {ratio:9.2f} {target:>7s}")
+    rows += study_rows() + answer_rows()
+    print_targets(rows)
     print("all times measured in this run, on this machine")
 
 

@@ -16,6 +16,7 @@ import time
 from pathlib import Path
 
 from components.kernels import path_environment
+from orchestrator.studies.timing import print_targets
 
 PROJECT = Path(__file__).resolve().parents[2]
 SCENE = PROJECT / "scenarios" / "m739_study.toml"
@@ -64,5 +65,4 @@ def study_rows() -> list[tuple[str, float, str]]:
 
 
 def print_study_speed() -> None:
-    for what, ratio, target in study_rows():
-        print(f"{what}: {ratio:.2f} (target {target})")
+    print_targets(study_rows())
